@@ -1,0 +1,13 @@
+# Every third-party package rocklab uses, found once. Versions are Debian 12's.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)      # Eigen3::Eigen
+find_package(OpenMP REQUIRED)                    # OpenMP::OpenMP_CXX
+find_package(CLI11 CONFIG REQUIRED)              # CLI11::CLI11
+find_package(nlohmann_json 3 REQUIRED)           # nlohmann_json::nlohmann_json
+find_package(tomlplusplus REQUIRED)              # tomlplusplus::tomlplusplus
+find_package(fmt REQUIRED)                       # fmt::fmt
+find_package(assimp REQUIRED)                    # assimp::assimp
+# List the VTK components: without them find_package(VTK) looks for Qt5 and fails.
+find_package(VTK 9.1 REQUIRED COMPONENTS IOXML CommonCore CommonDataModel)
+# FindHDF5 picks the serial build even when VTK pulled in the OpenMPI one.
+find_package(HDF5 REQUIRED COMPONENTS C CXX)     # hdf5::hdf5, hdf5::hdf5_cpp
+find_package(Catch2 2 REQUIRED)                  # Catch2::Catch2

@@ -1,0 +1,19 @@
+# Shared compile flags: every rocklab target links rocklab_warnings.
+add_library(rocklab_warnings INTERFACE)
+target_compile_options(rocklab_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wno-unknown-pragmas
+  # GCC 12 false positive on std::string concatenation (GCC bug 105329).
+  $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>
+  # Determinism: no fused multiply-add contraction, so results do not depend on
+  # which code path the compiler picked for a loop.
+  -ffp-contract=off)
+if(ROCKLAB_WERROR)
+  target_compile_options(rocklab_warnings INTERFACE -Werror)
+endif()
+if(ROCKLAB_NATIVE)
+  target_compile_options(rocklab_warnings INTERFACE -march=native)
+endif()
+if(ROCKLAB_SANITIZE)
+  target_compile_options(rocklab_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
+  target_link_options(rocklab_warnings INTERFACE -fsanitize=address,undefined)
+endif()

@@ -1,0 +1,34 @@
+#pragma once
+// Running a scene: builds the world, steps it with progress on stderr, writes
+// run.h5 / .vtp series / checkpoint.h5 / results.json into the output directory.
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "rocklab/experiments/scene.h"
+
+namespace rocklab::experiments {
+
+/// Exit codes of the CLI.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitBadInput = 2,     // scene, option or file the user gave is unusable; nothing written
+  kExitWatchdog = 3,     // the stability watchdog stopped the run; outputs so far kept
+  kExitInterrupted = 130,  // Ctrl-C; outputs so far kept and readable
+};
+
+struct RunOptions {
+  std::filesystem::path out_dir = "out";
+  int threads = 0;           // 0 = all cores
+  bool progress = true;      // progress line on stderr for runs over a few seconds
+  std::filesystem::path restart;  // checkpoint to continue from ("" = start at t = 0)
+};
+
+/// Runs a loaded scene. Returns an ExitCode; writes messages to `log`.
+int runScene(const Scene& scene, const RunOptions& options, std::ostream& log);
+
+/// Requests a clean stop of the running scene (called from the SIGINT handler).
+void requestStop();
+
+}  // namespace rocklab::experiments

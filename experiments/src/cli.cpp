@@ -1,0 +1,146 @@
+#include "rocklab/experiments/cli.h"
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <fstream>
+#include <iostream>
+
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+#include "rocklab/sim/output/checkpoint.h"
+#include "rocklab/sim/world.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+constexpr const char* kExamples = R"(
+Examples:
+  rocklab demo                                   # default scene end to end, outputs in out/demo
+  rocklab list                                   # built-in scenes
+  rocklab run pour --out runs/pour               # a built-in scene by name
+  rocklab run my.toml --set timestep.safety_factor=0.3 --set output.vtk=true
+  rocklab check my.toml                          # validate and print the time-step audit only
+  rocklab restart runs/pour/checkpoint.h5 --set scene.end_time=2.0 --out runs/pour2
+
+Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
+watchdog, 130 interrupted by Ctrl-C (outputs so far are kept and readable).
+Units are SI everywhere (m, s, kg, N, Pa).)";
+
+extern "C" void onSigint(int) {
+  requestStop();
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the process at once
+}
+
+std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+int doList() {
+  std::cout << "built-in scenes (" << builtinSceneDir().string() << "):\n";
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(builtinSceneDir()))
+    if (e.path().extension() == ".toml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    std::string description;
+    try {
+      description = loadScene(f).run.description;
+    } catch (const SceneError& e) {
+      description = std::string("(invalid: ") + e.what() + ")";
+    }
+    std::cout << "  " << f.stem().string() << std::string(std::max<std::size_t>(2, 16 - f.stem().string().size()), ' ')
+              << firstLine(description) << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int runCli(int argc, const char* const* argv) {
+  CLI::App app{"rocklab: DEM workbench for laboratory experiments on rock flow and breakage"};
+  app.footer(kExamples);
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "rocklab 0.1.0");
+
+  std::string scene_arg, checkpoint_arg, out_dir;
+  std::vector<std::string> overrides;
+  int threads = 0;
+  bool quiet = false;
+  auto addRunOptions = [&](CLI::App* c) {
+    c->add_option("--out", out_dir, "Output directory (default: out/<scene name>)");
+    c->add_option("--set", overrides, "Override a scene key, e.g. --set timestep.dt=1e-6 (TOML value)")
+        ->take_all();
+    c->add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
+    c->add_flag("--quiet", quiet, "No progress line");
+  };
+  auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
+  run->add_option("scene", scene_arg, "Scene TOML file or built-in name (see `rocklab list`)")->required();
+  addRunOptions(run);
+  auto* demo = app.add_subcommand("demo", "Run the default demo scene end to end");
+  addRunOptions(demo);
+  auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
+  restart->add_option("checkpoint", checkpoint_arg, "checkpoint.h5 written by an earlier run")->required();
+  addRunOptions(restart);
+  auto* check = app.add_subcommand("check", "Validate a scene and print its time-step audit without running");
+  check->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
+  check->add_option("--set", overrides, "Override a scene key")->take_all();
+  app.add_subcommand("list", "List the built-in scenes");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+
+  if (app.got_subcommand("list")) return doList();
+
+  Scene scene;
+  RunOptions options;
+  options.threads = threads;
+  options.progress = !quiet;
+  try {
+    if (app.got_subcommand("restart")) {
+      // The checkpoint carries the scene text it was run with.
+      const sim::output::Checkpoint cp = sim::output::readCheckpoint(checkpoint_arg);
+      scene = loadSceneText(cp.scene_text, checkpoint_arg + ":/scene", overrides,
+                            std::filesystem::path(checkpoint_arg).parent_path());
+      options.restart = checkpoint_arg;
+    } else {
+      const std::string name = app.got_subcommand("demo") ? "demo" : scene_arg;
+      scene = loadScene(resolveScene(name), overrides);
+    }
+  } catch (const SceneError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const sim::output::CheckpointError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+
+  if (app.got_subcommand("check")) {
+    try {
+      sim::World world(scene.model, scene.spheres, 1);
+      std::cout << scene.source.string() << ": valid; " << scene.spheres.size() << " spheres, "
+                << scene.model.walls.size() << " walls\n"
+                << world.timestepAudit().describe(scene.model.timestep) << "\n";
+      return kExitOk;
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "error: " << scene.source.string() << ": " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+
+  options.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(out_dir);
+  std::signal(SIGINT, onSigint);
+  const int code = runScene(scene, options, std::cerr);
+  std::signal(SIGINT, SIG_DFL);
+  return code;
+}
+
+}  // namespace rocklab::experiments

@@ -1,0 +1,299 @@
+#include "rocklab/experiments/run.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+
+#include "rocklab/sim/output/checkpoint.h"
+#include "rocklab/sim/output/run_file.h"
+#include "rocklab/sim/output/vtk_series.h"
+#include "rocklab/sim/world.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+/// Writes text to path atomically (temporary file in the same folder, then rename).
+void writeAtomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path tmp = path.string() + ".partial";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string hex(std::uint64_t v) {
+  std::ostringstream s;
+  s << std::hex << std::setw(16) << std::setfill('0') << v;
+  return s.str();
+}
+
+std::size_t peakRssBytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<std::size_t>(u.ru_maxrss) * 1024;
+}
+
+std::string clockText(double s) {
+  std::ostringstream o;
+  const auto total = static_cast<long>(std::lround(s));
+  o << total / 3600 << ':' << std::setw(2) << std::setfill('0') << (total / 60) % 60 << ':' << std::setw(2)
+    << total % 60;
+  return o.str();
+}
+
+/// Progress on stderr: a line every 2 s on a terminal (overwritten), every 15 s otherwise.
+class Progress {
+ public:
+  Progress(bool enabled, std::uint64_t total_steps, double dt)
+      : enabled_(enabled), tty_(isatty(STDERR_FILENO)), total_(total_steps), dt_(dt),
+        start_(Clock::now()), last_(start_) {}
+  void update(std::uint64_t done, const std::string& extra) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (seconds(last_, now) < (tty_ ? 2.0 : 15.0)) return;
+    last_ = now;
+    const double elapsed = seconds(start_, now);
+    const double rate = done / std::max(elapsed, 1e-9);
+    const double eta = (total_ - done) / std::max(rate, 1e-9);
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(4) << "t = " << done * dt_ << " / " << total_ * dt_ << " s  "
+      << std::setprecision(1) << 100.0 * done / total_ << "%  " << std::setprecision(0) << rate
+      << " steps/s  ETA " << clockText(eta) << "  " << extra;
+    std::cerr << (tty_ ? "\r" : "") << s.str() << (tty_ ? "\033[K" : "\n") << std::flush;
+    printed_ = true;
+  }
+  void finish() {
+    if (enabled_ && tty_ && printed_) std::cerr << "\n";
+  }
+
+ private:
+  bool enabled_, tty_;
+  std::uint64_t total_;
+  double dt_;
+  Clock::time_point start_, last_;
+  bool printed_ = false;
+};
+
+}  // namespace
+
+void requestStop() { g_stop = true; }
+
+int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
+  const auto t_start = Clock::now();
+  g_stop = false;
+  namespace fs = std::filesystem;
+  namespace out = sim::output;
+
+  // --- set-up: everything that can fail on bad input happens before any output.
+  std::unique_ptr<sim::World> world;
+  std::string scene_text = scene.text;
+  try {
+    if (!options.restart.empty()) {
+      out::Checkpoint cp = out::readCheckpoint(options.restart);
+      world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
+    } else {
+      world = std::make_unique<sim::World>(scene.model, scene.spheres, options.threads);
+    }
+  } catch (const out::CheckpointError& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string()) << ": "
+        << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const double dt = world->dt();
+  const std::uint64_t total_steps =
+      scene.run.steps > 0 ? scene.run.steps
+                          : static_cast<std::uint64_t>(std::llround(scene.run.end_time / dt));
+  auto stepsFor = [dt](double interval) -> std::uint64_t {
+    return interval > 0 ? std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(interval / dt))) : 0;
+  };
+  const std::uint64_t frame_every = stepsFor(scene.run.frame_interval);
+  const std::uint64_t energy_every = stepsFor(scene.run.energy_interval);
+  const std::uint64_t checkpoint_every = stepsFor(scene.run.checkpoint_interval);
+
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  if (ec) {
+    log << "error: cannot create output directory " << options.out_dir << ": " << ec.message() << "\n";
+    return kExitBadInput;
+  }
+
+  // Active modules: what this scene constructs (and so pays for).
+  const sim::Model& model = world->model();
+  std::vector<std::string> modules;
+  modules.push_back(model.contact.law == sim::ContactLaw::Linear ? "contact:linear" : "contact:hertz_mindlin");
+  if (model.contact.damping_normal > 0 || model.contact.damping_shear > 0) modules.push_back("damping:viscous");
+  if (model.contact.local_damping > 0) modules.push_back("damping:local");
+  for (const char* shape : {"plane", "polygon", "mesh"}) {
+    for (const auto& w : model.walls) {
+      const char* s = w.shape == sim::WallShape::Plane ? "plane" : w.shape == sim::WallShape::Polygon ? "polygon" : "mesh";
+      if (std::string(s) == shape) {
+        modules.push_back(std::string("walls:") + shape);
+        break;
+      }
+    }
+  }
+  bool moving = false;
+  for (const auto& w : model.walls) moving = moving || !w.motion.isStatic();
+  if (moving) modules.push_back("walls:moving");
+  if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
+  if (scene.run.hdf5) modules.push_back("output:hdf5");
+  if (scene.run.vtk) modules.push_back("output:vtk");
+  if (scene.run.checkpoint) modules.push_back("output:checkpoint");
+
+  log << "rocklab: scene '" << scene.run.name << "'" << (options.restart.empty() ? "" : " (restart)") << ", "
+      << world->particles().size() << " spheres, " << model.walls.size() << " walls, " << world->threads()
+      << " threads\n";
+  log << "  modules: ";
+  for (std::size_t k = 0; k < modules.size(); ++k) log << (k ? ", " : "") << modules[k];
+  log << "\n" << world->timestepAudit().describe(model.timestep) << "\n";
+  log << "  steps: " << total_steps << " from t = " << world->time() << " s, output to " << options.out_dir.string()
+      << "\n";
+
+  std::unique_ptr<out::RunFile> run_file;
+  std::unique_ptr<out::VtkSeries> vtk;
+  if (scene.run.hdf5) run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene_text);
+  if (scene.run.vtk) vtk = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "particles");
+  const auto t_setup = Clock::now();
+
+  // --- stepping
+  double output_seconds = 0.0;
+  std::string status = "completed", message;
+  int exit_code = kExitOk;
+  sim::Snapshot last;  // figures of the last observed step
+  std::size_t frames = 0;
+  bool frame_due = false;  // set by the loop before an observed step
+  auto observer = [&](const sim::Snapshot& s) {
+    const auto t0 = Clock::now();
+    last.time = s.time;
+    last.step = s.step;
+    last.energy = s.energy;
+    last.contacts = s.contacts;
+    last.wall_contacts = s.wall_contacts;
+    if (run_file) {
+      run_file->appendEnergy(s);
+      if (frame_due) run_file->writeFrame(s);
+    }
+    if (vtk && frame_due) vtk->writeFrame(s);
+    if (frame_due) ++frames;
+    output_seconds += seconds(t0, Clock::now());
+  };
+  auto writeCheckpoint = [&]() {
+    if (!scene.run.checkpoint) return;
+    const auto t0 = Clock::now();
+    out::writeCheckpoint(options.out_dir / "checkpoint.h5", world->exportState(), scene_text);
+    output_seconds += seconds(t0, Clock::now());
+  };
+
+  Progress progress(options.progress, total_steps, dt);
+  const std::uint64_t first_step = world->stepCount();
+  const std::uint64_t end_step = std::max(total_steps, first_step);
+  const auto t_loop = Clock::now();
+  try {
+    while (world->stepCount() < end_step) {
+      if (g_stop) {
+        status = "interrupted";
+        exit_code = kExitInterrupted;
+        break;
+      }
+      // Frames at t = 0, every frame interval and at the last step; energy rows
+      // at frames and every energy interval.
+      const std::uint64_t k = world->stepCount();
+      frame_due = k == first_step || k + 1 >= end_step || (frame_every && k % frame_every == 0);
+      if (frame_due || (energy_every && k % energy_every == 0))
+        world->step(observer);
+      else
+        world->step();
+      if (checkpoint_every && world->stepCount() % checkpoint_every == 0) writeCheckpoint();
+      progress.update(world->stepCount(), "");
+    }
+  } catch (const sim::WatchdogError& e) {
+    status = "stopped_by_watchdog";
+    message = e.what();
+    exit_code = kExitWatchdog;
+  }
+  const auto t_loop_end = Clock::now();
+  progress.finish();
+  if (exit_code != kExitWatchdog) writeCheckpoint();  // a blown-up state is no place to restart from
+  const auto t_out = Clock::now();
+  if (run_file) run_file->close(exit_code != kExitOk);
+  const std::size_t vtk_frames = vtk ? vtk->frameCount() : 0;
+  output_seconds += seconds(t_out, Clock::now());
+
+  const double stepping = seconds(t_loop, t_loop_end) - output_seconds;
+  const std::uint64_t steps_done = world->stepCount() - first_step;
+  const auto& audit = world->timestepAudit();
+  nlohmann::json r;
+  r["scene"] = scene.run.name;
+  r["status"] = status;
+  if (!message.empty()) r["message"] = message;
+  r["particles"] = world->particles().size();
+  r["walls"] = model.walls.size();
+  r["threads"] = world->threads();
+  r["modules"] = modules;
+  r["seed"] = scene.run.seed;
+  r["steps"] = world->stepCount();
+  r["steps_this_run"] = steps_done;
+  r["dt_s"] = dt;
+  r["simulated_time_s"] = world->time();
+  r["timestep"] = {{"critical_s", audit.critical},
+                   {"spring_translational_s", audit.spring_translational},
+                   {"spring_rotational_s", audit.spring_rotational},
+                   {"rayleigh_s", audit.rayleigh},
+                   {"hertz_contact_time_s", audit.hertz_contact_time},
+                   {"linear_contact_time_s", audit.linear_contact_time},
+                   {"automatic_s", audit.automatic},
+                   {"dt_over_critical", dt / audit.critical}};
+  r["wall_time_s"] = {{"setup", seconds(t_start, t_setup)},
+                      {"stepping", stepping},
+                      {"output", output_seconds},
+                      {"total", seconds(t_start, Clock::now())}};
+  r["particle_steps_per_s"] = stepping > 0 ? world->particles().size() * steps_done / stepping : 0.0;
+  r["neighbour_rebuilds"] = world->stats().neighbour_rebuilds;
+  r["pairs_in_list"] = world->stats().pairs_in_list;
+  r["last_observed"] = {{"time_s", last.time},
+                        {"contacts", last.contacts},
+                        {"wall_contacts", last.wall_contacts},
+                        {"energy_J",
+                         {{"kinetic_translational", last.energy.kinetic_translational},
+                          {"kinetic_rotational", last.energy.kinetic_rotational},
+                          {"potential_gravity", last.energy.potential_gravity},
+                          {"elastic", last.energy.elastic}}}};
+  r["state_hash"] = hex(world->stateHash());
+  r["peak_rss_bytes"] = peakRssBytes();
+  r["outputs"] = {{"run_h5", scene.run.hdf5 ? "run.h5" : ""},
+                  {"frames", frames},
+                  {"vtk_frames", vtk_frames},
+                  {"checkpoint", scene.run.checkpoint && exit_code != kExitWatchdog ? "checkpoint.h5" : ""}};
+  writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
+
+  if (!message.empty()) log << "error: " << message << "\n";
+  log << "rocklab: " << status << " at t = " << world->time() << " s after " << steps_done << " steps; wall time "
+      << std::fixed << std::setprecision(2) << seconds(t_start, Clock::now()) << " s (stepping " << stepping
+      << " s, " << std::scientific << std::setprecision(3) << r["particle_steps_per_s"].get<double>()
+      << " particle-steps/s); results in " << (options.out_dir / "results.json").string() << "\n";
+  return exit_code;
+}
+
+}  // namespace rocklab::experiments

@@ -1,0 +1,286 @@
+#include "toml_reader.h"
+
+#include <sstream>
+
+namespace rocklab::experiments::detail {
+
+namespace {
+std::string fmtValue(const toml::node& n) {
+  std::ostringstream s;
+  if (auto str = n.as_string()) s << '"' << str->get() << '"';
+  else if (n.is_table()) s << "a table";
+  else if (n.is_array_of_tables()) s << "an array of tables";
+  else n.visit([&s](const auto& v) { s << v; });
+  return s.str();
+}
+std::string typeName(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date/time";
+  }
+}
+}  // namespace
+
+std::string Range::describe() const {
+  std::ostringstream s;
+  if (std::isinf(lo) && std::isinf(hi)) return "any number";
+  if (std::isinf(hi)) {
+    s << (lo_open ? "> " : ">= ") << lo;
+    return s.str();
+  }
+  if (std::isinf(lo)) {
+    s << (hi_open ? "< " : "<= ") << hi;
+    return s.str();
+  }
+  s << (lo_open ? "(" : "[") << lo << ", " << hi << (hi_open ? ")" : "]");
+  return s.str();
+}
+
+std::string where(const toml::source_region& src) {
+  std::ostringstream s;
+  const std::string file = src.path ? *src.path : std::string("<scene>");
+  s << file;
+  if (file.rfind("--set", 0) != 0 && src.begin.line > 0) s << ':' << src.begin.line;
+  s << ": ";
+  return s.str();
+}
+
+TableReader::TableReader(const toml::table& table, std::string path,
+                         std::shared_ptr<const Overrides> overrides)
+    : table_(&table), path_(std::move(path)), overrides_(std::move(overrides)) {}
+
+std::string TableReader::keyPath(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void TableReader::fail(const std::string& key, const std::string& what) const {
+  const toml::node* n = table_->get(key);
+  const toml::source_region& src = n ? n->source() : table_->source();
+  std::ostringstream s;
+  const auto over = overrides_ ? overrides_->find(keyPath(key)) : Overrides::const_iterator{};
+  if (overrides_ && over != overrides_->end())
+    s << "--set " << over->second << ": ";
+  else
+    s << where(src);
+  s << "key '" << keyPath(key) << "'";
+  if (n) s << " = " << fmtValue(*n);
+  s << ": " << what;
+  throw SceneError(s.str());
+}
+
+bool TableReader::has(const std::string& key) const { return table_->contains(key); }
+
+const toml::node* TableReader::node(const std::string& key) {
+  used_.insert(key);
+  return table_->get(key);
+}
+
+double TableReader::number(const std::string& key, double fallback, Range range) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  double v;
+  if (auto f = n->as_floating_point()) v = f->get();
+  else if (auto i = n->as_integer()) v = static_cast<double>(i->get());
+  else fail(key, "expected a number, got " + typeName(*n) + "; allowed: " + range.describe());
+  if (!std::isfinite(v) || !range.contains(v)) fail(key, "out of range; allowed: " + range.describe());
+  return v;
+}
+
+double TableReader::requiredNumber(const std::string& key, Range range) {
+  if (!has(key)) fail(key, "missing; a number " + range.describe() + " is required");
+  return number(key, 0.0, range);
+}
+
+std::int64_t TableReader::integer(const std::string& key, std::int64_t fallback, Range range) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto i = n->as_integer();
+  if (!i) fail(key, "expected an integer, got " + typeName(*n) + "; allowed: " + range.describe());
+  if (!range.contains(static_cast<double>(i->get())))
+    fail(key, "out of range; allowed: " + range.describe());
+  return i->get();
+}
+
+bool TableReader::boolean(const std::string& key, bool fallback) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto b = n->as_boolean();
+  if (!b) fail(key, "expected true or false, got " + typeName(*n));
+  return b->get();
+}
+
+std::string TableReader::string(const std::string& key, const std::string& fallback,
+                                const std::vector<std::string>& allowed) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto s = n->as_string();
+  std::string options;
+  for (const auto& a : allowed) options += (options.empty() ? "" : ", ") + ("\"" + a + "\"");
+  if (!s) fail(key, "expected a string, got " + typeName(*n) + (allowed.empty() ? "" : "; allowed: " + options));
+  if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s->get()) == allowed.end())
+    fail(key, "not allowed; allowed: " + options);
+  return s->get();
+}
+
+std::string TableReader::requiredString(const std::string& key, const std::vector<std::string>& allowed) {
+  if (!has(key)) {
+    std::string options;
+    for (const auto& a : allowed) options += (options.empty() ? "" : ", ") + ("\"" + a + "\"");
+    fail(key, "missing; a string is required" + (allowed.empty() ? "" : " (" + options + ")"));
+  }
+  return string(key, "", allowed);
+}
+
+geometry::Vec3 TableReader::vec3(const std::string& key, const geometry::Vec3& fallback) {
+  const toml::node* n = node(key);
+  if (!n) return fallback;
+  auto a = n->as_array();
+  if (!a || a->size() != 3) fail(key, "expected an array of 3 numbers [x, y, z]");
+  geometry::Vec3 v;
+  for (int k = 0; k < 3; ++k) {
+    const toml::node& e = *a->get(static_cast<std::size_t>(k));
+    if (auto f = e.as_floating_point()) v[k] = f->get();
+    else if (auto i = e.as_integer()) v[k] = static_cast<double>(i->get());
+    else fail(key, "expected an array of 3 numbers [x, y, z]");
+    if (!std::isfinite(v[k])) fail(key, "components must be finite");
+  }
+  return v;
+}
+
+geometry::Vec3 TableReader::requiredVec3(const std::string& key) {
+  if (!has(key)) fail(key, "missing; an array of 3 numbers [x, y, z] is required");
+  return vec3(key, geometry::Vec3::Zero());
+}
+
+std::vector<geometry::Vec3> TableReader::vec3List(const std::string& key) {
+  const toml::node* n = node(key);
+  std::vector<geometry::Vec3> out;
+  if (!n) return out;
+  auto a = n->as_array();
+  if (!a) fail(key, "expected an array of [x, y, z] arrays");
+  for (const toml::node& e : *a) {
+    auto p = e.as_array();
+    if (!p || p->size() != 3) fail(key, "expected an array of [x, y, z] arrays");
+    geometry::Vec3 v;
+    for (int k = 0; k < 3; ++k) {
+      const toml::node& c = *p->get(static_cast<std::size_t>(k));
+      if (auto f = c.as_floating_point()) v[k] = f->get();
+      else if (auto i = c.as_integer()) v[k] = static_cast<double>(i->get());
+      else fail(key, "expected an array of [x, y, z] arrays of numbers");
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<double> TableReader::numberList(const std::string& key, Range range) {
+  const toml::node* n = node(key);
+  std::vector<double> out;
+  if (!n) return out;
+  auto a = n->as_array();
+  if (!a) fail(key, "expected an array of numbers " + range.describe());
+  for (const toml::node& e : *a) {
+    double v;
+    if (auto f = e.as_floating_point()) v = f->get();
+    else if (auto i = e.as_integer()) v = static_cast<double>(i->get());
+    else fail(key, "expected an array of numbers " + range.describe());
+    if (!range.contains(v)) fail(key, "an element is out of range; allowed: " + range.describe());
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::optional<TableReader> TableReader::table(const std::string& key) {
+  const toml::node* n = node(key);
+  if (!n) return std::nullopt;
+  auto t = n->as_table();
+  if (!t) fail(key, "expected a table ([" + keyPath(key) + "]), got " + typeName(*n));
+  return TableReader(*t, keyPath(key), overrides_);
+}
+
+std::vector<TableReader> TableReader::tableArray(const std::string& key) {
+  const toml::node* n = node(key);
+  std::vector<TableReader> out;
+  if (!n) return out;
+  auto a = n->as_array();
+  if (!a || !a->is_array_of_tables()) fail(key, "expected an array of tables ([[" + keyPath(key) + "]])");
+  for (std::size_t k = 0; k < a->size(); ++k)
+    out.emplace_back(*a->get(k)->as_table(), keyPath(key) + "." + std::to_string(k), overrides_);
+  return out;
+}
+
+std::vector<std::string> TableReader::keys() const {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : *table_) out.emplace_back(k.str());
+  return out;
+}
+
+void TableReader::finish() const {
+  for (const auto& [k, v] : *table_) {
+    const std::string key(k.str());
+    if (used_.count(key)) continue;
+    std::string allowed;
+    for (const auto& u : used_) allowed += (allowed.empty() ? "" : ", ") + u;
+    std::ostringstream s;
+    s << where(v.source()) << "unknown key '" << keyPath(key) << "'";
+    if (!allowed.empty()) s << "; known keys here: " << allowed;
+    throw SceneError(s.str());
+  }
+}
+
+void applyOverride(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("--set " + assignment + ": expected key=value, e.g. --set timestep.dt=1e-6");
+  const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  // The value is TOML; a bare word that is not TOML is taken as a string.
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value, "--set " + key);
+  } catch (const toml::parse_error&) {
+    try {
+      parsed = toml::parse("v = \"" + value + "\"", "--set " + key);
+    } catch (const toml::parse_error&) {
+      throw SceneError("--set " + assignment + ": the value is not valid TOML");
+    }
+  }
+  // Walk the dotted path; numeric parts index arrays of tables.
+  toml::node* cur = &root;
+  std::string part;
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  while (std::getline(ss, part, '.')) parts.push_back(part);
+  for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
+    if (auto t = cur->as_table()) {
+      toml::node* next = t->get(parts[k]);
+      if (!next) {
+        t->insert(parts[k], toml::table{});
+        next = t->get(parts[k]);
+      }
+      cur = next;
+    } else if (auto a = cur->as_array()) {
+      std::size_t idx = 0;
+      try {
+        idx = std::stoul(parts[k]);
+      } catch (...) {
+        throw SceneError("--set " + assignment + ": '" + parts[k] + "' must be an index into an array");
+      }
+      if (idx >= a->size())
+        throw SceneError("--set " + assignment + ": index " + parts[k] + " is beyond the " +
+                         std::to_string(a->size()) + " entries");
+      cur = a->get(idx);
+    } else {
+      throw SceneError("--set " + assignment + ": '" + parts[k] + "' is not a table");
+    }
+  }
+  auto t = cur->as_table();
+  if (!t) throw SceneError("--set " + assignment + ": the parent of the last key is not a table");
+  t->insert_or_assign(parts.back(), *parsed.get("v"));
+}
+
+}  // namespace rocklab::experiments::detail

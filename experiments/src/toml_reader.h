@@ -1,0 +1,78 @@
+#pragma once
+// Checked access to a TOML table: every read names its key, type and range, and
+// finish() rejects keys that nobody read (pbrt's "unused parameter" rule).
+#include <toml++/toml.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "rocklab/experiments/scene.h"
+#include "rocklab/geometry/vec.h"
+
+namespace rocklab::experiments::detail {
+
+/// An interval of allowed values, printed in messages as e.g. "(0, 1]".
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false, hi_open = false;
+  static Range positive() { return {0.0, std::numeric_limits<double>::infinity(), true, false}; }
+  static Range nonNegative() { return {0.0, std::numeric_limits<double>::infinity(), false, false}; }
+  static Range closed(double a, double b) { return {a, b, false, false}; }
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string describe() const;
+};
+
+class TableReader {
+ public:
+  /// Dotted key -> the --set assignment that gave it (messages then name the override).
+  using Overrides = std::map<std::string, std::string>;
+  /// `path` is the dotted key of this table ("" for the root), for messages.
+  TableReader(const toml::table& table, std::string path,
+              std::shared_ptr<const Overrides> overrides = nullptr);
+
+  bool has(const std::string& key) const;
+  double number(const std::string& key, double fallback, Range range = {});
+  double requiredNumber(const std::string& key, Range range = {});
+  std::int64_t integer(const std::string& key, std::int64_t fallback, Range range = {});
+  bool boolean(const std::string& key, bool fallback);
+  std::string string(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& allowed = {});
+  std::string requiredString(const std::string& key, const std::vector<std::string>& allowed = {});
+  geometry::Vec3 vec3(const std::string& key, const geometry::Vec3& fallback);
+  geometry::Vec3 requiredVec3(const std::string& key);
+  std::vector<geometry::Vec3> vec3List(const std::string& key);
+  std::vector<double> numberList(const std::string& key, Range range = {});
+  std::optional<TableReader> table(const std::string& key);
+  std::vector<TableReader> tableArray(const std::string& key);
+  /// Names of all keys of this table (for tables of named entries).
+  std::vector<std::string> keys() const;
+
+  /// Throws for the first key that was never read.
+  void finish() const;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  std::string keyPath(const std::string& key) const;
+  const toml::table& raw() const { return *table_; }
+
+ private:
+  const toml::node* node(const std::string& key);
+  const toml::table* table_;
+  std::string path_;
+  std::set<std::string> used_;
+  std::shared_ptr<const Overrides> overrides_;
+};
+
+/// "file:line: " for a node.
+std::string where(const toml::source_region& src);
+/// Sets `key.path=value` in `root`; throws SceneError naming the override.
+void applyOverride(toml::table& root, const std::string& assignment);
+
+}  // namespace rocklab::experiments::detail

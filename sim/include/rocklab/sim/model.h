@@ -1,0 +1,112 @@
+#pragma once
+// The constant part of a simulation (MuJoCo's "model"): materials, contact law,
+// walls, gravity schedule and engine settings. A World holds a Model and the
+// mutable state; nothing here changes while a run steps.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rocklab/geometry/triangle_mesh.h"
+#include "rocklab/geometry/vec.h"
+
+namespace rocklab::sim {
+
+/// Properties of one material (a ball or a wall carries one).
+struct Material {
+  std::string name;
+  double density = 2730.0;      // kg/m^3 (balls only)
+  double kn = 1e9;              // N/m   normal stiffness of this entity (linear law, Eq 2-20)
+  double ks = 1e9;              // N/m   shear stiffness of this entity (linear law, Eq 2-21)
+  double friction = 0.37;       // -     Coulomb coefficient; a pair uses the smaller (ref §5)
+  double shear_modulus = 0.0;   // Pa    G (Hertz–Mindlin, Eq 2-22)
+  double poisson = 0.2;         // -     nu (Hertz–Mindlin)
+};
+
+enum class ContactLaw { Linear, HertzMindlin };
+
+/// Mass used in the critical damping of a ball–ball dashpot (Eq 2-18).
+enum class DampingMass {
+  Average,  // the study's choice: (m_A + m_B) / 2
+  Reduced,  // the usual two-body value: m_A m_B / (m_A + m_B)
+};
+
+struct ContactModel {
+  ContactLaw law = ContactLaw::Linear;
+  double damping_normal = 0.0;  // -  beta_n, critical damping ratio of the normal dashpot (Eq 2-17)
+  double damping_shear = 0.0;   // -  beta_s, same for the shear dashpot
+  DampingMass damping_mass = DampingMass::Average;
+  double local_damping = 0.0;   // -  alpha of Cundall's local damping (Eq 2-15, sign form)
+};
+
+/// Prescribed motion of a wall: x(t) = pivot + T(t) + R(t) (x0 - pivot), with
+/// T(t) = velocity t + amplitude sin(2 pi frequency t) and R(t) the rotation by
+/// angular_velocity t about the pivot.
+struct WallMotion {
+  geometry::Vec3 velocity = geometry::Vec3::Zero();          // m/s
+  geometry::Vec3 angular_velocity = geometry::Vec3::Zero();  // rad/s
+  geometry::Vec3 pivot = geometry::Vec3::Zero();             // m
+  geometry::Vec3 amplitude = geometry::Vec3::Zero();         // m, oscillation
+  double frequency = 0.0;                                    // Hz, oscillation
+  bool isStatic() const {
+    return velocity.isZero(0) && angular_velocity.isZero(0) && (amplitude.isZero(0) || frequency == 0.0);
+  }
+};
+
+enum class WallShape { Plane, Polygon, Mesh };
+
+struct Wall {
+  std::string name;
+  WallShape shape = WallShape::Plane;
+  // Plane: a point and the unit normal pointing into the region where balls live.
+  geometry::Vec3 point = geometry::Vec3::Zero();
+  geometry::Vec3 normal = geometry::Vec3::UnitZ();
+  // Polygon: convex, planar, vertices in order. Mesh: triangles.
+  std::vector<geometry::Vec3> vertices;
+  geometry::TriangleMesh mesh;
+  int material = 0;
+  WallMotion motion;
+  double active_from = -std::numeric_limits<double>::infinity();   // s
+  double active_until = std::numeric_limits<double>::infinity();   // s
+  bool activeAt(double t) const { return t >= active_from && t < active_until; }
+};
+
+/// Gravity switches to `vector` at `time` (a chute tilts by turning gravity).
+struct GravityChange {
+  double time = 0.0;                                // s
+  geometry::Vec3 vector = geometry::Vec3::Zero();  // m/s^2
+};
+
+struct TimestepSettings {
+  double safety_factor = 0.5;  // -  dt = safety_factor * dt_crit (spring criterion)
+  double dt = 0.0;             // s  requested step; 0 = automatic; may only lower the automatic one
+  double impact_velocity = 5.0;  // m/s  used for the Hertz contact-time line of the audit
+  bool allow_unsafe = false;     // accept a dt above the automatic one (stability tests only)
+};
+
+struct WatchdogSettings {
+  double max_overlap_fraction = 0.5;  // -  overlap / smaller radius that stops the run
+  double max_energy_growth = 0.1;     // -  allowed rise of mechanical energy, fraction of its scale
+  int check_interval = 100;           // steps between energy checks
+};
+
+struct Model {
+  std::vector<Material> materials;
+  ContactModel contact;
+  std::vector<Wall> walls;
+  geometry::Vec3 gravity = geometry::Vec3(0, 0, -9.81);  // m/s^2 at t = 0
+  std::vector<GravityChange> gravity_changes;           // sorted by time
+  TimestepSettings timestep;
+  WatchdogSettings watchdog;
+  double skin = 0.0;  // m  Verlet skin; 0 = 0.2 x mean radius
+};
+
+/// A sphere to add to a world.
+struct SphereSpec {
+  geometry::Vec3 position = geometry::Vec3::Zero();  // m
+  geometry::Vec3 velocity = geometry::Vec3::Zero();  // m/s
+  geometry::Vec3 omega = geometry::Vec3::Zero();     // rad/s
+  double radius = 0.01;                              // m
+  int material = 0;
+};
+
+}  // namespace rocklab::sim

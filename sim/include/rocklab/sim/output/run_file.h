@@ -1,0 +1,44 @@
+#pragma once
+// run.h5: the trajectory file of one run (HDF5).
+//
+// Layout (all values SI; every dataset carries a "unit" string attribute):
+//   /                      attrs: format = "rocklab-run", version = 1, complete (int 0/1),
+//                                 interrupted (int 0/1)
+//   /scene                 string dataset: the scene file text as run (after --set overrides)
+//   /frames/000000, ...    one group per frame, attrs time (s), step;
+//                          datasets position [n,3] m, velocity [n,3] m/s, omega [n,3] rad/s,
+//                          force [n,3] N, radius [n] m, id [n] uint64
+//   /energy                [rows, 8] double, extendible and chunked; columns (attr "columns"):
+//                          time s, step, kinetic_translational J, kinetic_rotational J,
+//                          potential_gravity J, elastic J, total J, contacts
+//
+// Safe writing: the file is written as `<path>.partial` and renamed to `<path>`
+// by close(), so a good run.h5 is never replaced by a half-written one. The file
+// is flushed after every frame, so even the .partial of a killed run is readable.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "rocklab/sim/snapshot.h"
+
+namespace rocklab::sim::output {
+
+class RunFile {
+ public:
+  RunFile(const std::filesystem::path& path, const std::string& scene_text);
+  ~RunFile();  // closes without renaming if close() was not called (keeps the .partial)
+  RunFile(const RunFile&) = delete;
+  RunFile& operator=(const RunFile&) = delete;
+
+  void writeFrame(const Snapshot& snapshot);
+  void appendEnergy(const Snapshot& snapshot);
+  std::size_t frameCount() const;
+  /// Marks the file complete (or interrupted), closes it and renames it into place.
+  void close(bool interrupted);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rocklab::sim::output

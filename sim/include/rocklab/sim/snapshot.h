@@ -1,0 +1,37 @@
+#pragma once
+// What observers (output writers, energy log, watchdog) see at a whole step t:
+// positions at t and velocities synchronised to t (v(t) = v(t - dt/2) + a(t) dt/2,
+// the velocity-Verlet value), with the total force and torque at t.
+#include <cstdint>
+#include <span>
+
+#include "rocklab/geometry/vec.h"
+
+namespace rocklab::sim {
+
+struct Energy {
+  double kinetic_translational = 0.0;  // J
+  double kinetic_rotational = 0.0;     // J
+  double potential_gravity = 0.0;      // J, -sum m g.x (datum at the origin)
+  double elastic = 0.0;                // J, stored in normal and shear contact springs
+  double total() const {
+    return kinetic_translational + kinetic_rotational + potential_gravity + elastic;
+  }
+};
+
+struct Snapshot {
+  double time = 0.0;         // s
+  std::uint64_t step = 0;    // steps since t = 0
+  std::span<const geometry::Vec3> position;  // [n] m
+  std::span<const geometry::Vec3> velocity;  // [n] m/s, synchronised to `time`
+  std::span<const geometry::Vec3> omega;     // [n] rad/s, synchronised to `time`
+  std::span<const geometry::Vec3> force;     // [n] N, total including gravity
+  std::span<const double> radius;            // [n] m
+  std::span<const std::uint64_t> id;         // [n]
+  Energy energy;
+  std::size_t contacts = 0;       // touching ball–ball pairs
+  std::size_t wall_contacts = 0;  // touching ball–wall pairs
+  double max_overlap_fraction = 0.0;  // max overlap / smaller radius over contacts
+};
+
+}  // namespace rocklab::sim

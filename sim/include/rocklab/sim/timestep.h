@@ -1,0 +1,51 @@
+#pragma once
+// Critical time steps (ref. dem-models.md §7a, [X]) and the start-up audit.
+#include <string>
+
+#include "rocklab/sim/model.h"
+#include "rocklab/sim/particles.h"
+
+namespace rocklab::sim {
+
+/// Spring criterion for one body: min(sqrt(m / k_n), sqrt(I / (k_s R^2))).
+double springCriticalStep(double mass, double inertia, double radius, double kn, double ks);
+
+/// Rayleigh-wave step: pi R sqrt(rho / G) / (0.1631 nu + 0.8766).
+double rayleighStep(double radius, double density, double shear_modulus, double poisson);
+
+/// Normal force coefficient c of F = c delta^(3/2) for the study's Hertz law (Eq 2-22).
+double hertzCoefficient(double shear_modulus, double poisson, double r_tilde);
+
+/// Largest overlap of an undamped Hertz impact: (5 m v^2 / (4 c))^(2/5).
+double hertzMaxOverlap(double mass, double c, double velocity);
+
+/// Duration of an undamped Hertz impact: 2.9432 delta_max / v.
+double hertzContactTime(double mass, double c, double velocity);
+
+/// Duration of a linear spring–dashpot contact: pi / (omega0 sqrt(1 - beta^2)).
+double linearContactTime(double mass, double k, double beta);
+
+/// Restitution of a linear spring–dashpot contact, Eq 4-4: exp(-beta pi / sqrt(1 - beta^2)).
+double restitutionFromDamping(double beta);
+/// Inverse of Eq 4-4: beta = -ln e / sqrt(pi^2 + ln^2 e).
+double dampingFromRestitution(double restitution);
+
+struct TimestepAudit {
+  double spring_translational = 0.0;  // s  sqrt(m/k_n), stiffest pair of the lightest body
+  double spring_rotational = 0.0;     // s  sqrt(I/(k_s R^2))
+  double critical = 0.0;              // s  min of the two
+  double rayleigh = 0.0;              // s  0 when no shear modulus is given (linear law)
+  double hertz_contact_time = 0.0;    // s  at impact_velocity; 0 for the linear law
+  double linear_contact_time = 0.0;   // s  lightest ball on its stiffest partner; 0 for Hertz
+  double automatic = 0.0;             // s  safety_factor * critical
+  double chosen = 0.0;                // s
+  double ratio() const { return chosen / critical; }
+  std::string describe(const TimestepSettings& settings) const;
+};
+
+/// Audits the step for the given balls against every partner they can meet
+/// (other balls' materials and every wall). Throws std::invalid_argument when a
+/// requested dt exceeds the automatic one (unless timestep.allow_unsafe).
+TimestepAudit auditTimestep(const Model& model, const ParticleState& particles);
+
+}  // namespace rocklab::sim

@@ -1,0 +1,115 @@
+#pragma once
+// The force–displacement law at one contact (ref §3–§6), specialised at compile
+// time for the contact law. Internal to rocklab_sim.
+#include <algorithm>
+#include <cmath>
+
+#include "rocklab/sim/model.h"
+
+namespace rocklab::sim::detail {
+
+using geometry::Vec3;
+
+/// Constants of one material pair (ball–ball or ball–wall), computed once.
+struct PairProps {
+  double kn = 0.0;         // N/m  linear: series normal stiffness (Eq 2-20)
+  double ks = 0.0;         // N/m  linear: series shear stiffness (Eq 2-21)
+  double friction = 0.0;   // -    min of the two (ref §5)
+  double hertz_cn = 0.0;   // N/m^2 Hertz: 2 G sqrt(2) / (3 (1 - nu)); times sqrt(R~) gives c
+  double hertz_ks = 0.0;   // Hertz: 2 (3 G^2 (1 - nu))^(1/3) / (2 - nu); times (R~ F)^(1/3) gives k_s
+};
+
+PairProps ballBallProps(const Material& a, const Material& b);
+/// Mirror rule for Hertz (ref §4.2): the ball's own G and nu; series springs for linear.
+PairProps ballWallProps(const Material& ball, const Material& wall);
+
+/// Input of one contact evaluation.
+struct ContactGeometry {
+  Vec3 normal;        // unit, from the body the force acts on (A) towards the other (B)
+  double overlap;     // m, > 0
+  Vec3 rel_velocity;  // m/s, velocity of B relative to A at the contact point
+  double r_tilde;     // m, Eq 2-24 (ball–wall: the ball radius)
+  double damping_mass;  // kg, Eq 2-18
+};
+
+struct ContactResult {
+  Vec3 force;          // N on body A
+  double normal_elastic;  // N, K^n U^n (Eq 2-2), >= 0
+};
+
+struct LinearLaw {
+  static constexpr bool kHertz = false;
+  // Returns the secant normal stiffness K^n and the tangent one dF/dU.
+  static void normal(const PairProps& p, double /*overlap*/, double /*r_tilde*/, double& secant,
+                     double& tangent) {
+    secant = tangent = p.kn;
+  }
+  static double shear(const PairProps& p, double /*fn*/, double /*r_tilde*/) { return p.ks; }
+};
+
+struct HertzMindlinLaw {
+  static constexpr bool kHertz = true;
+  static void normal(const PairProps& p, double overlap, double r_tilde, double& secant,
+                     double& tangent) {
+    // Eq 2-22: K^n = c sqrt(U^n), so F = c U^(3/2) and dF/dU = 3/2 K^n.
+    secant = p.hertz_cn * std::sqrt(r_tilde * overlap);
+    tangent = 1.5 * secant;
+  }
+  static double shear(const PairProps& p, double fn, double r_tilde) {
+    // Eq 2-23: K^s = 2 (3 G^2 (1 - nu) R~)^(1/3) / (2 - nu) |F^n|^(1/3).
+    return p.hertz_ks * std::cbrt(r_tilde * fn);
+  }
+};
+
+/// Evaluates one contact and updates its shear-force history `shear` (force on A).
+template <class Law>
+inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
+                                     const ContactGeometry& g, double dt, Vec3& shear) {
+  const Vec3& n = g.normal;
+  double kn_secant, kn_tangent;
+  Law::normal(p, g.overlap, g.r_tilde, kn_secant, kn_tangent);
+  const double fn_elastic = kn_secant * g.overlap;  // Eq 2-2
+  const double vn = g.rel_velocity.dot(n);          // < 0 while approaching
+  const Vec3 vt = g.rel_velocity - vn * n;
+  // Normal dashpot, Eq 2-16..2-18 with the tangent stiffness; may pull (recorded choice).
+  const double cn = 2.0 * cm.damping_normal * std::sqrt(g.damping_mass * kn_tangent);
+  const double fn_total = fn_elastic - cn * vn;
+
+  // Shear spring: rotate the stored force into the current tangent plane keeping
+  // its magnitude ([X] note (i) of §3), then add the increment (Eq 2-3..2-5).
+  const double old_mag2 = shear.squaredNorm();
+  if (old_mag2 > 0.0) {
+    shear -= shear.dot(n) * n;
+    const double new_mag2 = shear.squaredNorm();
+    if (new_mag2 > 0.0) shear *= std::sqrt(old_mag2 / new_mag2);
+  }
+  const double ks = Law::shear(p, fn_elastic, g.r_tilde);
+  shear += (ks * dt) * vt;  // B moving along +vt drags A along +vt
+  // Coulomb limit on the elastic normal force (Eq 2-39). While slipping, the
+  // spring stays at the limit and the shear dashpot is off (PFC convention, [X]).
+  const double limit = p.friction * fn_elastic;
+  Vec3 ft;
+  const double mag2 = shear.squaredNorm();
+  if (mag2 > limit * limit) {
+    shear *= limit / std::sqrt(mag2);
+    ft = shear;
+  } else {
+    const double cs = 2.0 * cm.damping_shear * std::sqrt(g.damping_mass * ks);
+    ft = shear + cs * vt;
+  }
+  return {ft - fn_total * n, fn_elastic};
+}
+
+/// Elastic energy stored at a contact (normal + shear spring).
+template <class Law>
+inline double elasticEnergy(const PairProps& p, double overlap, double r_tilde, const Vec3& shear) {
+  double secant, tangent;
+  Law::normal(p, overlap, r_tilde, secant, tangent);
+  const double fn = secant * overlap;
+  // Linear: F U / 2; Hertz: integral of c U^(3/2) = 2/5 F U.
+  const double normal = (Law::kHertz ? 0.4 : 0.5) * fn * overlap;
+  const double ks = Law::shear(p, fn, r_tilde);
+  return normal + (ks > 0.0 ? 0.5 * shear.squaredNorm() / ks : 0.0);
+}
+
+}  // namespace rocklab::sim::detail

@@ -1,0 +1,49 @@
+#pragma once
+// Neighbour search: all ball pairs closer than r_i + r_j + skin, found with a
+// hierarchy of uniform grids (one level per doubling of the radius), so that a
+// 7:1 size ratio costs little more than monodisperse: a ball searches the 27
+// cells around it in its own level and in every coarser level; each level's cell
+// size is set by its largest ball. Internal to rocklab_sim.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rocklab/geometry/vec.h"
+
+namespace rocklab::sim::detail {
+
+using geometry::Vec3;
+
+/// Pairs in compressed rows: row i lists partners j > i in ascending order.
+/// `col_*` is the transpose: for ball j, the indices of the pairs (i, j), i < j,
+/// in ascending i. Both orders are canonical, so sums over them are the same
+/// whatever the number of threads and whenever the list was rebuilt.
+struct PairList {
+  std::vector<std::uint32_t> row_offset;  // [n+1]
+  std::vector<std::uint32_t> partner;     // [pairs] j of each pair
+  std::vector<std::uint32_t> col_offset;  // [n+1]
+  std::vector<std::uint32_t> col_pair;    // [pairs] pair index, grouped by j
+  std::size_t size() const { return partner.size(); }
+};
+
+class NeighborFinder {
+ public:
+  /// Rebuilds `out` for the given balls. `threads` as for OpenMP num_threads.
+  void build(std::span<const Vec3> position, std::span<const double> radius, double skin,
+             int threads, PairList& out);
+
+ private:
+  struct Level {
+    double cell = 0.0;           // m, edge of a cell
+    Vec3 origin = Vec3::Zero();  // m, corner of cell (0,0,0)
+    std::int64_t nx = 1, ny = 1, nz = 1;
+    std::vector<std::uint32_t> cell_start;  // [cells+1]
+    std::vector<std::uint32_t> members;     // ball indices, grouped by cell
+  };
+  std::vector<Level> levels_;
+  std::vector<std::uint8_t> level_of_;
+  std::vector<std::vector<std::uint64_t>> thread_keys_;
+  std::vector<std::uint64_t> keys_;
+};
+
+}  // namespace rocklab::sim::detail

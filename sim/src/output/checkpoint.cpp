@@ -1,0 +1,394 @@
+#include "rocklab/sim/output/checkpoint.h"
+
+#include <H5Cpp.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace rocklab::sim::output {
+namespace {
+
+constexpr const char* kFormat = "rocklab-checkpoint";
+constexpr int kFormatVersion = 1;
+
+// A Vec3 array is handed to HDF5 as [n,3] contiguous doubles.
+static_assert(sizeof(Vec3) == 3 * sizeof(double));
+
+// How a C++ array element is stored: its HDF5 type and the number of columns of
+// the dataset (0 = a 1-D dataset). Memory and file use the same native types, so
+// HDF5 copies the bytes unchanged and a read gives back the same bits.
+template <class T>
+struct Layout;
+template <>
+struct Layout<double> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<std::uint64_t> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_UINT64; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<std::uint32_t> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_UINT32; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<std::int32_t> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_INT32; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<Vec3> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
+  static constexpr hsize_t columns = 3;
+};
+
+/// The contact-history arrays are stored column by column: two uint32 indices
+/// and the shear force [k,3] N.
+template <class History>
+struct HistoryLayout {
+  const char* group;
+  const char* first_name;
+  std::uint32_t History::*first;
+  const char* second_name;
+  std::uint32_t History::*second;
+};
+constexpr HistoryLayout<PairHistory> kPairLayout{"pairs", "i", &PairHistory::i, "j",
+                                                 &PairHistory::j};
+constexpr HistoryLayout<WallHistory> kWallLayout{"walls", "particle", &WallHistory::particle,
+                                                 "wall", &WallHistory::wall};
+
+std::string quoted(const std::filesystem::path& path) {
+  return "'" + path.string() + "'";
+}
+
+std::string describe(const H5::Exception& e) {
+  return "HDF5 error in " + e.getFuncName() + ": " + e.getDetailMsg();
+}
+
+/// Returns "" or what makes the state unusable (array sizes that disagree,
+/// history that refers to missing particles).
+std::string inconsistency(const WorldState& state) {
+  const ParticleState& p = state.particles;
+  const std::size_t n = p.size();
+  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", p.velocity.size()},
+                                                       {"omega", p.omega.size()},
+                                                       {"radius", p.radius.size()},
+                                                       {"inv_mass", p.inv_mass.size()},
+                                                       {"inv_inertia", p.inv_inertia.size()},
+                                                       {"material", p.material.size()},
+                                                       {"mass", p.mass.size()},
+                                                       {"id", p.id.size()}};
+  for (const auto& [name, size] : sizes) {
+    if (size != n) {
+      return "inconsistent array sizes: particles/" + std::string(name) + " has " +
+             std::to_string(size) + " entries but particles/position has " + std::to_string(n);
+    }
+  }
+  for (const PairHistory& h : state.pair_history) {
+    if (h.i >= n || h.j >= n) {
+      return "pair history refers to particle pair (" + std::to_string(h.i) + ", " +
+             std::to_string(h.j) + ") but there are " + std::to_string(n) + " particles";
+    }
+  }
+  for (const WallHistory& h : state.wall_history) {
+    if (h.particle >= n) {
+      return "wall history refers to particle " + std::to_string(h.particle) + " but there are " +
+             std::to_string(n) + " particles";
+    }
+  }
+  return {};
+}
+
+// ---------------------------------------------------------------- writing
+
+H5::StrType textType() {
+  // Variable-length UTF-8: scene text of any length, with any characters.
+  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+  type.setCset(H5T_CSET_UTF8);
+  return type;
+}
+
+void writeTextAttribute(const H5::H5Object& object, const char* name, const std::string& value) {
+  const H5::StrType type = textType();
+  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
+}
+
+template <class T>
+void writeScalarAttribute(const H5::H5Object& object, const char* name, const H5::PredType& type,
+                          T value) {
+  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, &value);
+}
+
+/// Writes `values` as a dataset of shape [n] or [n,3] with a "unit" attribute.
+template <class T>
+void writeArray(const H5::Group& group, const char* name, const std::vector<T>& values,
+                const char* unit) {
+  const std::array<hsize_t, 2> dims{values.size(), Layout<T>::columns};
+  const H5::DataSpace space(Layout<T>::columns == 0 ? 1 : 2, dims.data());
+  const H5::DataSet dataset = group.createDataSet(name, Layout<T>::type(), space);
+  if (!values.empty()) dataset.write(values.data(), Layout<T>::type());  // no buffer when n = 0
+  writeTextAttribute(dataset, "unit", unit);
+}
+
+void writeText(const H5::Group& group, const char* name, const std::string& text) {
+  const H5::StrType type = textType();
+  const H5::DataSet dataset = group.createDataSet(name, type, H5::DataSpace(H5S_SCALAR));
+  dataset.write(text, type);
+  writeTextAttribute(dataset, "unit", "");
+}
+
+/// One member of every element, in order.
+template <class Row, class Member>
+std::vector<Member> column(const std::vector<Row>& rows, Member Row::*member) {
+  std::vector<Member> values;
+  values.reserve(rows.size());
+  for (const Row& row : rows) values.push_back(row.*member);
+  return values;
+}
+
+template <class History>
+void writeHistory(const H5::Group& root, const HistoryLayout<History>& layout,
+                  const std::vector<History>& rows) {
+  const H5::Group group = root.createGroup(layout.group);
+  writeArray(group, layout.first_name, column(rows, layout.first), "");
+  writeArray(group, layout.second_name, column(rows, layout.second), "");
+  writeArray(group, "shear", column(rows, &History::shear), "N");
+}
+
+void writeParticles(const H5::Group& root, const ParticleState& p) {
+  const H5::Group group = root.createGroup("particles");
+  writeArray(group, "position", p.position, "m");
+  writeArray(group, "velocity", p.velocity, "m/s");
+  writeArray(group, "omega", p.omega, "rad/s");
+  writeArray(group, "radius", p.radius, "m");
+  writeArray(group, "inv_mass", p.inv_mass, "1/kg");
+  writeArray(group, "inv_inertia", p.inv_inertia, "1/(kg m^2)");
+  writeArray(group, "mass", p.mass, "kg");
+  writeArray(group, "material", p.material, "");
+  writeArray(group, "id", p.id, "");
+}
+
+void writeFile(const std::filesystem::path& path, const WorldState& state,
+               const std::string& scene_text) {
+  H5::H5File file(path.string(), H5F_ACC_TRUNC);
+  writeTextAttribute(file, "format", kFormat);
+  writeScalarAttribute(file, "version", H5::PredType::NATIVE_INT, kFormatVersion);
+  writeScalarAttribute(file, "time", H5::PredType::NATIVE_DOUBLE, state.time);
+  writeScalarAttribute(file, "step", H5::PredType::NATIVE_UINT64, state.step);
+  writeScalarAttribute(file, "dt", H5::PredType::NATIVE_DOUBLE, state.dt);
+  writeScalarAttribute(file, "half_kick_pending", H5::PredType::NATIVE_INT,
+                       state.half_kick_pending ? 1 : 0);
+  writeText(file, "scene", scene_text);
+  writeParticles(file, state.particles);
+  writeHistory(file, kPairLayout, state.pair_history);
+  writeHistory(file, kWallLayout, state.wall_history);
+  file.close();
+}
+
+// ---------------------------------------------------------------- reading
+
+/// Reads one checkpoint file; every complaint names the file.
+class Reader {
+ public:
+  explicit Reader(std::filesystem::path path)
+      : path_(std::move(path)), file_(path_.string(), H5F_ACC_RDONLY) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw CheckpointError("checkpoint " + quoted(path_) + ": " + what);
+  }
+
+  void checkFormat() const {
+    if (!file_.attrExists("format")) fail("not a rocklab checkpoint (no 'format' attribute)");
+    const H5::Attribute stored = file_.openAttribute("format");
+    std::string format;
+    if (stored.getTypeClass() == H5T_STRING && points(stored.getSpace()) == 1) {
+      stored.read(stored.getStrType(), format);
+    }
+    if (format != kFormat) {
+      fail("not a rocklab checkpoint (format is '" + format + "', expected '" + kFormat + "')");
+    }
+    const int version = attribute<int>("version");
+    if (version != kFormatVersion) {
+      fail("unsupported checkpoint version " + std::to_string(version) + " (this build reads " +
+           std::to_string(kFormatVersion) + ")");
+    }
+  }
+
+  template <class T>
+  T attribute(const char* name) const {
+    if (!file_.attrExists(name)) fail(std::string("missing attribute '") + name + "'");
+    const H5::Attribute stored = file_.openAttribute(name);
+    // A scalar is read into one T: a larger attribute would overrun it.
+    if (points(stored.getSpace()) != 1) {
+      fail(std::string("attribute '") + name + "' is not a scalar");
+    }
+    T value{};
+    stored.read(nativeScalarType<T>(), &value);
+    return value;
+  }
+
+  std::string text(const std::string& name) const {
+    const H5::DataSet dataset = openDataSet(name);
+    if (dataset.getTypeClass() != H5T_STRING || points(dataset.getSpace()) != 1) {
+      fail("dataset " + name + " is not a single string");
+    }
+    std::string value;
+    dataset.read(value, dataset.getStrType());
+    return value;
+  }
+
+  /// Reads a dataset of shape [n] or [n,3] (as Layout<T> says) into a vector.
+  template <class T>
+  std::vector<T> array(const std::string& name) const {
+    const H5::DataSet dataset = openDataSet(name);
+    const H5::DataSpace space = dataset.getSpace();
+    const int rank = space.getSimpleExtentNdims();
+    const int expected_rank = Layout<T>::columns == 0 ? 1 : 2;
+    std::array<hsize_t, 2> dims{0, 0};
+    if (rank == expected_rank) space.getSimpleExtentDims(dims.data());
+    if (rank != expected_rank || (expected_rank == 2 && dims[1] != Layout<T>::columns)) {
+      fail("dataset " + name + " has the wrong shape (expected " +
+           (expected_rank == 1 ? std::string("[n]")
+                               : "[n," + std::to_string(Layout<T>::columns) + "]") +
+           ")");
+    }
+    std::vector<T> values(dims[0]);
+    if (!values.empty()) dataset.read(values.data(), Layout<T>::type());
+    return values;
+  }
+
+ private:
+  static hssize_t points(const H5::DataSpace& space) { return space.getSimpleExtentNpoints(); }
+
+  template <class T>
+  static const H5::PredType& nativeScalarType() {
+    if constexpr (std::is_same_v<T, int>) {
+      return H5::PredType::NATIVE_INT;
+    } else {
+      return Layout<T>::type();
+    }
+  }
+
+  /// Opens `name` (an absolute path), saying which part of it is missing.
+  H5::DataSet openDataSet(const std::string& name) const {
+    // H5Lexists fails, rather than saying false, when a group on the way is
+    // missing, so every level is checked in turn.
+    for (std::size_t slash = name.find('/', 1);; slash = name.find('/', slash + 1)) {
+      const std::string prefix = name.substr(0, slash);
+      if (!file_.nameExists(prefix)) fail("missing " + prefix);
+      if (slash == std::string::npos) break;
+    }
+    if (file_.childObjType(name) != H5O_TYPE_DATASET) fail(name + " is not a dataset");
+    return file_.openDataSet(name);
+  }
+
+  std::filesystem::path path_;
+  H5::H5File file_;
+};
+
+template <class History>
+std::vector<History> readHistory(const Reader& in, const HistoryLayout<History>& layout) {
+  const std::string group = "/" + std::string(layout.group) + "/";
+  const auto first = in.array<std::uint32_t>(group + layout.first_name);
+  const auto second = in.array<std::uint32_t>(group + layout.second_name);
+  const auto shear = in.array<Vec3>(group + "shear");
+  if (second.size() != first.size() || shear.size() != first.size()) {
+    in.fail("inconsistent array sizes in " + group + ": " + layout.first_name + " " +
+            std::to_string(first.size()) + ", " + layout.second_name + " " +
+            std::to_string(second.size()) + ", shear " + std::to_string(shear.size()));
+  }
+  std::vector<History> rows(first.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    rows[k].*layout.first = first[k];
+    rows[k].*layout.second = second[k];
+    rows[k].shear = shear[k];
+  }
+  return rows;
+}
+
+ParticleState readParticles(const Reader& in) {
+  ParticleState p;
+  p.position = in.array<Vec3>("/particles/position");
+  p.velocity = in.array<Vec3>("/particles/velocity");
+  p.omega = in.array<Vec3>("/particles/omega");
+  p.radius = in.array<double>("/particles/radius");
+  p.inv_mass = in.array<double>("/particles/inv_mass");
+  p.inv_inertia = in.array<double>("/particles/inv_inertia");
+  p.mass = in.array<double>("/particles/mass");
+  p.material = in.array<std::int32_t>("/particles/material");
+  p.id = in.array<std::uint64_t>("/particles/id");
+  return p;
+}
+
+Checkpoint readFile(const Reader& in) {
+  in.checkFormat();
+  Checkpoint checkpoint;
+  checkpoint.scene_text = in.text("/scene");
+  WorldState& state = checkpoint.state;
+  state.time = in.attribute<double>("time");
+  state.step = in.attribute<std::uint64_t>("step");
+  state.dt = in.attribute<double>("dt");
+  state.half_kick_pending = in.attribute<int>("half_kick_pending") != 0;
+  state.particles = readParticles(in);
+  state.pair_history = readHistory(in, kPairLayout);
+  state.wall_history = readHistory(in, kWallLayout);
+  if (const std::string problem = inconsistency(state); !problem.empty()) in.fail(problem);
+  return checkpoint;
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
+                     const std::string& scene_text) {
+  H5::Exception::dontPrint();  // errors reach the caller as exceptions instead
+  const auto fail = [&](const std::string& what) {
+    return CheckpointError("cannot write checkpoint " + quoted(path) + ": " + what);
+  };
+  if (const std::string problem = inconsistency(state); !problem.empty()) throw fail(problem);
+
+  // Written beside the target and renamed over it, so an existing checkpoint is
+  // replaced in one step and a crash never leaves a half-written one.
+  std::filesystem::path temporary = path;
+  temporary += ".tmp";
+  std::error_code error;
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), error);
+  try {
+    writeFile(temporary, state, scene_text);
+  } catch (const H5::Exception& e) {
+    std::filesystem::remove(temporary, error);
+    throw fail(describe(e));
+  }
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    throw fail("cannot rename " + quoted(temporary) + ": " + error.message());
+  }
+}
+
+Checkpoint readCheckpoint(const std::filesystem::path& path) {
+  H5::Exception::dontPrint();  // errors reach the caller as exceptions instead
+  const auto fail = [&](const std::string& what) {
+    return CheckpointError("checkpoint " + quoted(path) + ": " + what);
+  };
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw fail("file does not exist");
+  if (!std::filesystem::is_regular_file(path, error)) throw fail("not a regular file");
+  try {
+    if (!H5::H5File::isHdf5(path.string())) {
+      throw fail("not a rocklab checkpoint (not an HDF5 file)");
+    }
+    return readFile(Reader(path));
+  } catch (const H5::Exception& e) {
+    throw fail(describe(e));
+  }
+}
+
+}  // namespace rocklab::sim::output

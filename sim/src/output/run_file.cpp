@@ -1,0 +1,259 @@
+#include "rocklab/sim/output/run_file.h"
+
+#include <H5Cpp.h>
+
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <span>
+#include <stdexcept>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+
+#include "rocklab/sim/particles.h"  // sim::Vec3
+
+namespace rocklab::sim::output {
+namespace {
+
+constexpr int kFormatVersion = 1;
+constexpr hsize_t kEnergyColumns = 8;
+// 256 rows x 8 doubles = 16 KiB per chunk: large enough for efficient I/O, small
+// enough that a short run wastes little space.
+constexpr hsize_t kEnergyChunkRows = 256;
+constexpr const char* kEnergyColumnNames =
+    "time [s], step [-], kinetic_translational [J], kinetic_rotational [J], "
+    "potential_gravity [J], elastic [J], total [J], contacts [-]";
+// The table mixes quantities, so its "unit" lists one unit per column.
+constexpr const char* kEnergyUnits = "s, -, J, J, J, J, J, -";
+
+// A Vec3 array is handed to HDF5 as [n,3] contiguous doubles.
+static_assert(sizeof(Vec3) == 3 * sizeof(double));
+
+// How a C++ array element is stored: its HDF5 type and the number of columns of
+// the dataset (0 = a 1-D dataset).
+template <class T>
+struct Layout;
+template <>
+struct Layout<double> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<std::uint64_t> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_UINT64; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<Vec3> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
+  static constexpr hsize_t columns = 3;
+};
+
+H5::StrType textType() {
+  // Variable-length UTF-8: scene text of any length, with any characters.
+  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
+  type.setCset(H5T_CSET_UTF8);
+  return type;
+}
+
+void writeTextAttribute(const H5::H5Object& object, const char* name, const std::string& value) {
+  const H5::StrType type = textType();
+  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
+}
+
+template <class T>
+void writeScalarAttribute(const H5::H5Object& object, const char* name, const H5::PredType& type,
+                          T value) {
+  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, &value);
+}
+
+void setIntAttribute(const H5::H5Object& object, const char* name, int value) {
+  object.openAttribute(name).write(H5::PredType::NATIVE_INT, &value);
+}
+
+/// Writes `values` as a dataset of shape [n] or [n,3] with a "unit" attribute.
+template <class T>
+void writeArray(const H5::Group& group, const char* name, std::span<const T> values,
+                const char* unit) {
+  const std::array<hsize_t, 2> dims{values.size(), Layout<T>::columns};
+  const H5::DataSpace space(Layout<T>::columns == 0 ? 1 : 2, dims.data());
+  const H5::DataSet dataset = group.createDataSet(name, Layout<T>::type(), space);
+  if (!values.empty()) dataset.write(values.data(), Layout<T>::type());  // no buffer when n = 0
+  writeTextAttribute(dataset, "unit", unit);
+}
+
+void writeText(const H5::Group& group, const char* name, const std::string& text) {
+  const H5::StrType type = textType();
+  const H5::DataSet dataset = group.createDataSet(name, type, H5::DataSpace(H5S_SCALAR));
+  dataset.write(text, type);
+  writeTextAttribute(dataset, "unit", "");
+}
+
+H5::DataSet createEnergyTable(const H5::Group& group) {
+  const std::array<hsize_t, 2> dims{0, kEnergyColumns};
+  const std::array<hsize_t, 2> max_dims{H5S_UNLIMITED, kEnergyColumns};
+  const std::array<hsize_t, 2> chunk{kEnergyChunkRows, kEnergyColumns};
+  H5::DSetCreatPropList properties;  // extendible datasets must be chunked
+  properties.setChunk(2, chunk.data());
+  const H5::DataSet table =
+      group.createDataSet("energy", H5::PredType::NATIVE_DOUBLE,
+                          H5::DataSpace(2, dims.data(), max_dims.data()), properties);
+  writeTextAttribute(table, "unit", kEnergyUnits);
+  writeTextAttribute(table, "columns", kEnergyColumnNames);
+  return table;
+}
+
+/// Number of particles in a snapshot; throws when its arrays differ in length.
+std::size_t particleCount(const Snapshot& s) {
+  const std::size_t n = s.position.size();
+  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", s.velocity.size()},
+                                                       {"omega", s.omega.size()},
+                                                       {"force", s.force.size()},
+                                                       {"radius", s.radius.size()},
+                                                       {"id", s.id.size()}};
+  for (const auto& [name, size] : sizes) {
+    if (size != n) {
+      throw std::invalid_argument("snapshot: " + std::string(name) + " has " +
+                                  std::to_string(size) + " entries but position has " +
+                                  std::to_string(n));
+    }
+  }
+  return n;
+}
+
+std::string frameGroupName(std::size_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frames/%06zu", frame);
+  return name;
+}
+
+/// Runs an HDF5 action and turns its exception into one that names the file.
+template <class Action>
+void guarded(const std::filesystem::path& file, const char* what, Action&& action) {
+  try {
+    std::forward<Action>(action)();
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error("run file '" + file.string() + "': cannot " + what + " (" +
+                             e.getFuncName() + ": " + e.getDetailMsg() + ")");
+  }
+}
+
+}  // namespace
+
+struct RunFile::Impl {
+  Impl(std::filesystem::path final_path, std::filesystem::path partial_path,
+       const std::string& scene_text)
+      : path(std::move(final_path)),
+        partial(std::move(partial_path)),
+        file(partial.string(), H5F_ACC_TRUNC) {
+    writeTextAttribute(file, "format", "rocklab-run");
+    writeScalarAttribute(file, "version", H5::PredType::NATIVE_INT, kFormatVersion);
+    // Both stay 0 until close(): a .partial left by a killed run reads as neither.
+    writeScalarAttribute(file, "complete", H5::PredType::NATIVE_INT, 0);
+    writeScalarAttribute(file, "interrupted", H5::PredType::NATIVE_INT, 0);
+    writeText(file, "scene", scene_text);
+    file.createGroup("frames");
+    energy = createEnergyTable(file);
+    file.flush(H5F_SCOPE_GLOBAL);
+  }
+
+  void requireOpen(const char* operation) const {
+    if (!open) throw std::logic_error("RunFile::" + std::string(operation) + " after close()");
+  }
+
+  std::filesystem::path path;     // the finished file, created by close()
+  std::filesystem::path partial;  // `<path>.partial`, written while the run goes on
+  H5::H5File file;
+  H5::DataSet energy;
+  hsize_t energy_rows = 0;
+  std::size_t frames = 0;
+  bool open = true;
+};
+
+RunFile::RunFile(const std::filesystem::path& path, const std::string& scene_text) {
+  H5::Exception::dontPrint();  // errors reach the caller as exceptions instead
+  std::filesystem::path partial = path;
+  partial += ".partial";
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  guarded(partial, "create it", [&] { impl_ = std::make_unique<Impl>(path, partial, scene_text); });
+}
+
+RunFile::~RunFile() {
+  if (!impl_ || !impl_->open) return;
+  try {
+    impl_->file.close();  // the .partial stays: it holds every frame flushed so far
+  } catch (const H5::Exception&) {
+    // A destructor must not throw; the frames already flushed remain readable.
+  }
+}
+
+void RunFile::writeFrame(const Snapshot& snapshot) {
+  impl_->requireOpen("writeFrame");
+  particleCount(snapshot);  // checks the arrays before anything is written
+  guarded(impl_->partial, "write a frame", [&] {
+    const H5::Group frame = impl_->file.createGroup(frameGroupName(impl_->frames));
+    writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
+    writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
+    writeArray(frame, "position", snapshot.position, "m");
+    writeArray(frame, "velocity", snapshot.velocity, "m/s");
+    writeArray(frame, "omega", snapshot.omega, "rad/s");
+    writeArray(frame, "force", snapshot.force, "N");
+    writeArray(frame, "radius", snapshot.radius, "m");
+    writeArray(frame, "id", snapshot.id, "");
+    // Flushing makes the frame (and the energy rows before it) survive a kill.
+    impl_->file.flush(H5F_SCOPE_GLOBAL);
+  });
+  ++impl_->frames;
+}
+
+void RunFile::appendEnergy(const Snapshot& snapshot) {
+  impl_->requireOpen("appendEnergy");
+  const Energy& e = snapshot.energy;
+  const std::array<double, kEnergyColumns> row{snapshot.time,
+                                               static_cast<double>(snapshot.step),
+                                               e.kinetic_translational,
+                                               e.kinetic_rotational,
+                                               e.potential_gravity,
+                                               e.elastic,
+                                               e.total(),
+                                               static_cast<double>(snapshot.contacts)};
+  // Not flushed here: rows may come every few steps; the next frame's flush
+  // (or close) writes them out.
+  guarded(impl_->partial, "append an energy row", [&] {
+    const hsize_t r = impl_->energy_rows;
+    const std::array<hsize_t, 2> grown{r + 1, kEnergyColumns};
+    impl_->energy.extend(grown.data());
+    const std::array<hsize_t, 2> start{r, 0};
+    const std::array<hsize_t, 2> count{1, kEnergyColumns};
+    H5::DataSpace file_space = impl_->energy.getSpace();
+    file_space.selectHyperslab(H5S_SELECT_SET, count.data(), start.data());
+    const H5::DataSpace memory_space(2, count.data());
+    impl_->energy.write(row.data(), H5::PredType::NATIVE_DOUBLE, memory_space, file_space);
+  });
+  ++impl_->energy_rows;
+}
+
+std::size_t RunFile::frameCount() const {
+  return impl_->frames;
+}
+
+void RunFile::close(bool interrupted) {
+  impl_->requireOpen("close");
+  guarded(impl_->partial, "finish it", [&] {
+    setIntAttribute(impl_->file, "complete", interrupted ? 0 : 1);
+    setIntAttribute(impl_->file, "interrupted", interrupted ? 1 : 0);
+    impl_->file.close();
+  });
+  impl_->open = false;
+  // rename() replaces an existing run file in one step: readers see the old
+  // file or the new one, never a mixture.
+  std::error_code error;
+  std::filesystem::rename(impl_->partial, impl_->path, error);
+  if (error) {
+    throw std::runtime_error("run file: cannot rename '" + impl_->partial.string() + "' to '" +
+                             impl_->path.string() + "': " + error.message());
+  }
+}
+
+}  // namespace rocklab::sim::output

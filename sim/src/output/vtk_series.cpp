@@ -1,0 +1,206 @@
+#include "rocklab/sim/output/vtk_series.h"
+
+#include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkTypeUInt64Array.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <span>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+#include <utility>
+
+#include "rocklab/sim/particles.h"  // sim::Vec3
+
+namespace rocklab::sim::output {
+namespace {
+
+/// Number of particles in a snapshot; throws when its arrays differ in length.
+std::size_t particleCount(const Snapshot& s) {
+  const std::size_t n = s.position.size();
+  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", s.velocity.size()},
+                                                       {"omega", s.omega.size()},
+                                                       {"force", s.force.size()},
+                                                       {"radius", s.radius.size()},
+                                                       {"id", s.id.size()}};
+  for (const auto& [name, size] : sizes) {
+    if (size != n) {
+      throw std::invalid_argument("snapshot: " + std::string(name) + " has " +
+                                  std::to_string(size) + " entries but position has " +
+                                  std::to_string(n));
+    }
+  }
+  return n;
+}
+
+vtkSmartPointer<vtkDoubleArray> vectorArray(const char* name, std::span<const Vec3> values) {
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfComponents(3);
+  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    array->SetTypedTuple(static_cast<vtkIdType>(k), values[k].data());
+  }
+  return array;
+}
+
+vtkSmartPointer<vtkDoubleArray> scalarArray(const char* name, std::span<const double> values) {
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    array->SetValue(static_cast<vtkIdType>(k), values[k]);
+  }
+  return array;
+}
+
+vtkSmartPointer<vtkTypeUInt64Array> idArray(std::span<const std::uint64_t> values) {
+  auto array = vtkSmartPointer<vtkTypeUInt64Array>::New();
+  array->SetName("id");
+  array->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    array->SetValue(static_cast<vtkIdType>(k), values[k]);
+  }
+  return array;
+}
+
+/// The balls as points (one vertex cell each, so ParaView renders them) with
+/// their fields as point data; radius is the active scalar for glyph scaling.
+vtkSmartPointer<vtkPolyData> makePolyData(const Snapshot& snapshot) {
+  const auto n = static_cast<vtkIdType>(particleCount(snapshot));
+  vtkNew<vtkPoints> points;
+  points->SetData(vectorArray("position", snapshot.position));  // m, kept in double
+
+  vtkNew<vtkCellArray> vertices;
+  vertices->AllocateExact(n, n);
+  for (vtkIdType k = 0; k < n; ++k) vertices->InsertNextCell(1, &k);
+
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  poly->SetVerts(vertices);
+  vtkPointData* data = poly->GetPointData();
+  data->SetScalars(scalarArray("radius", snapshot.radius));    // m
+  data->AddArray(vectorArray("velocity", snapshot.velocity));  // m/s
+  data->AddArray(vectorArray("omega", snapshot.omega));        // rad/s
+  data->AddArray(vectorArray("force", snapshot.force));        // N
+  data->AddArray(idArray(snapshot.id));
+  return poly;
+}
+
+void writePolyData(vtkPolyData* poly, const std::filesystem::path& file) {
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetFileName(file.c_str());
+  writer->SetInputData(poly);
+  // Raw appended binary with zlib: compact and quick to load; base64 would
+  // only matter for files that must stay valid text.
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  writer->SetCompressorTypeToZLib();
+  if (writer->Write() != 1) {
+    throw std::runtime_error("cannot write VTK file '" + file.string() + "'");
+  }
+}
+
+/// Writes `target` through `write(temporary)` and a rename, so readers (such as
+/// ParaView reloading the series) never see a half-written file.
+void writeAtomically(const std::filesystem::path& target,
+                     const std::function<void(const std::filesystem::path&)>& write) {
+  std::filesystem::path temporary = target;
+  temporary += ".tmp";
+  try {
+    write(temporary);
+    std::filesystem::rename(temporary, target);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+}
+
+void writeText(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error("cannot write '" + file.string() + "'");
+}
+
+/// Shortest text that reads back as the same double (times like 0.1 stay "0.1").
+std::string formatTime(double seconds) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, seconds);
+  return std::string(buffer, result.ptr);
+}
+
+std::string xmlEscaped(std::string_view text) {
+  std::string escaped;
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        escaped += "&amp;";
+        break;
+      case '<':
+        escaped += "&lt;";
+        break;
+      case '>':
+        escaped += "&gt;";
+        break;
+      case '"':
+        escaped += "&quot;";
+        break;
+      default:
+        escaped += c;
+    }
+  }
+  return escaped;
+}
+
+std::string frameFileName(const std::string& basename, std::size_t frame) {
+  char number[32];
+  std::snprintf(number, sizeof number, "_%06zu.vtp", frame);
+  return basename + number;
+}
+
+}  // namespace
+
+VtkSeries::VtkSeries(std::filesystem::path directory, std::string basename)
+    : directory_(std::move(directory)), basename_(std::move(basename)) {
+  std::filesystem::create_directories(directory_);
+}
+
+void VtkSeries::writeFrame(const Snapshot& snapshot) {
+  const vtkSmartPointer<vtkPolyData> poly = makePolyData(snapshot);
+  const std::string name = frameFileName(basename_, entries_.size());
+  writeAtomically(directory_ / name,
+                  [&](const std::filesystem::path& file) { writePolyData(poly, file); });
+  entries_.emplace_back(snapshot.time, name);
+  writeCollection();  // the .pvd always lists every finished frame
+}
+
+void VtkSeries::writeCollection() const {
+  std::ostringstream xml;
+  xml << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\">\n"
+      << "  <Collection>\n";
+  for (const auto& [time, name] : entries_) {
+    // File names are relative: the .pvd sits in the same directory as the frames.
+    xml << "    <DataSet timestep=\"" << formatTime(time) << "\" group=\"\" part=\"0\" file=\""
+        << xmlEscaped(name) << "\"/>\n";
+  }
+  xml << "  </Collection>\n"
+      << "</VTKFile>\n";
+  writeAtomically(directory_ / (basename_ + ".pvd"),
+                  [&](const std::filesystem::path& file) { writeText(file, xml.str()); });
+}
+
+}  // namespace rocklab::sim::output

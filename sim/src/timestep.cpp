@@ -1,0 +1,146 @@
+#include "rocklab/sim/timestep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "contact_kernel.h"
+
+namespace rocklab::sim {
+
+double springCriticalStep(double mass, double inertia, double radius, double kn, double ks) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double translational = kn > 0 ? std::sqrt(mass / kn) : inf;
+  const double rotational = ks > 0 ? std::sqrt(inertia / (ks * radius * radius)) : inf;
+  return std::min(translational, rotational);
+}
+
+double rayleighStep(double radius, double density, double shear_modulus, double poisson) {
+  return std::numbers::pi * radius * std::sqrt(density / shear_modulus) /
+         (0.1631 * poisson + 0.8766);
+}
+
+double hertzCoefficient(double shear_modulus, double poisson, double r_tilde) {
+  return 2.0 * shear_modulus * std::sqrt(2.0 * r_tilde) / (3.0 * (1.0 - poisson));  // Eq 2-22
+}
+
+double hertzMaxOverlap(double mass, double c, double velocity) {
+  // Energy balance: m v^2 / 2 = integral of c d^(3/2) = 2/5 c d^(5/2).
+  return std::pow(5.0 * mass * velocity * velocity / (4.0 * c), 0.4);
+}
+
+double hertzContactTime(double mass, double c, double velocity) {
+  // t = 2 (d_max / v) * integral_0^1 dx / sqrt(1 - x^(5/2)) = 2.9432 d_max / v.
+  return 2.9432 * hertzMaxOverlap(mass, c, velocity) / velocity;
+}
+
+double linearContactTime(double mass, double k, double beta) {
+  return std::numbers::pi / (std::sqrt(k / mass) * std::sqrt(1.0 - beta * beta));
+}
+
+double restitutionFromDamping(double beta) {
+  return std::exp(-beta * std::numbers::pi / std::sqrt(1.0 - beta * beta));  // Eq 4-4
+}
+
+double dampingFromRestitution(double restitution) {
+  const double l = std::log(restitution);
+  return -l / std::sqrt(std::numbers::pi * std::numbers::pi + l * l);
+}
+
+std::string TimestepAudit::describe(const TimestepSettings& settings) const {
+  std::ostringstream s;
+  s.precision(4);
+  s << "time step audit:\n";
+  s << "  spring, translational sqrt(m/k_n)    " << spring_translational << " s\n";
+  s << "  spring, rotational sqrt(I/(k_s R^2)) " << spring_rotational << " s\n";
+  if (rayleigh > 0) s << "  Rayleigh                             " << rayleigh << " s\n";
+  if (hertz_contact_time > 0)
+    s << "  Hertz contact time at " << settings.impact_velocity << " m/s        "
+      << hertz_contact_time << " s (" << hertz_contact_time / chosen << " steps)\n";
+  if (linear_contact_time > 0)
+    s << "  linear contact time                  " << linear_contact_time << " s ("
+      << linear_contact_time / chosen << " steps)\n";
+  s << "  critical (min of springs)            " << critical << " s\n";
+  s << "  automatic = " << settings.safety_factor << " x critical        " << automatic << " s\n";
+  s << "  chosen dt                            " << chosen << " s  (dt/dt_crit = " << ratio()
+    << (settings.dt > 0 ? ", set by timestep.dt" : ", automatic") << ")";
+  return s.str();
+}
+
+TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) {
+  using detail::PairProps;
+  const double inf = std::numeric_limits<double>::infinity();
+  TimestepAudit a;
+  a.spring_translational = a.spring_rotational = inf;
+  const bool hertz = model.contact.law == ContactLaw::HertzMindlin;
+  const double v = model.timestep.impact_velocity;
+
+  // Materials actually present among the balls, and every wall's material.
+  std::vector<bool> ball_material(model.materials.size(), false);
+  for (int m : particles.material) ball_material[m] = true;
+  double lightest = inf, lightest_k = 0.0;
+  double rayleigh = inf, hertz_time = inf;
+
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const Material& mi = model.materials[particles.material[i]];
+    const double m = particles.mass[i], r = particles.radius[i];
+    const double inertia = 1.0 / particles.inv_inertia[i];
+    auto consider = [&](const PairProps& p, double m_star) {
+      double kn = p.kn, ks = p.ks;
+      if (hertz) {
+        // Tangent stiffnesses at the deepest overlap of an impact at `v`.
+        const double c = p.hertz_cn * std::sqrt(r);
+        const double d = hertzMaxOverlap(m_star, c, v);
+        kn = 1.5 * c * std::sqrt(d);
+        ks = p.hertz_ks * std::cbrt(r * c * d * std::sqrt(d));
+        hertz_time = std::min(hertz_time, hertzContactTime(m_star, c, v));
+      }
+      a.spring_translational = std::min(a.spring_translational, std::sqrt(m / kn));
+      a.spring_rotational = std::min(a.spring_rotational, std::sqrt(inertia / (ks * r * r)));
+      if (m < lightest || (m == lightest && kn > lightest_k)) {
+        lightest = m;
+        lightest_k = kn;
+      }
+    };
+    for (std::size_t k = 0; k < model.materials.size(); ++k)
+      if (ball_material[k]) consider(detail::ballBallProps(mi, model.materials[k]), 0.5 * m);
+    for (const Wall& w : model.walls) consider(detail::ballWallProps(mi, model.materials[w.material]), m);
+    if (mi.shear_modulus > 0)
+      rayleigh = std::min(rayleigh, rayleighStep(r, mi.density, mi.shear_modulus, mi.poisson));
+  }
+  a.critical = std::min(a.spring_translational, a.spring_rotational);
+  a.rayleigh = std::isfinite(rayleigh) ? rayleigh : 0.0;
+  a.hertz_contact_time = std::isfinite(hertz_time) ? hertz_time : 0.0;
+  if (!hertz && std::isfinite(lightest) && lightest_k > 0)
+    a.linear_contact_time = linearContactTime(0.5 * lightest, lightest_k, model.contact.damping_normal);
+
+  const TimestepSettings& ts = model.timestep;
+  if (!std::isfinite(a.critical)) {
+    // No ball can touch anything stiff (no balls, or no stiffness): nothing limits dt.
+    if (ts.dt <= 0)
+      throw std::invalid_argument(
+          "timestep: no contact limits the step (no balls or zero stiffness); set timestep.dt");
+    a.automatic = a.chosen = ts.dt;
+    a.critical = inf;
+    return a;
+  }
+  a.automatic = ts.safety_factor * a.critical;
+  a.chosen = a.automatic;
+  if (ts.dt > 0) {
+    if (ts.dt > a.automatic * (1.0 + 1e-12) && !ts.allow_unsafe) {
+      std::ostringstream s;
+      s << "timestep.dt = " << ts.dt << " s is larger than the automatic step " << a.automatic
+        << " s (timestep.safety_factor " << ts.safety_factor << " x critical " << a.critical
+        << " s); a scene may only lower the step: set timestep.dt <= " << a.automatic
+        << " s, or timestep.allow_unsafe = true to force it";
+      throw std::invalid_argument(s.str());
+    }
+    a.chosen = ts.dt;
+  }
+  return a;
+}
+
+}  // namespace rocklab::sim

@@ -1,0 +1,737 @@
+#include "rocklab/sim/world.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <sstream>
+
+#include "contact_kernel.h"
+#include "neighbor_list.h"
+#include "rocklab/geometry/closest_point.h"
+#include "wall_runtime.h"
+
+namespace rocklab::sim {
+
+using detail::PairProps;
+
+namespace {
+
+// Reduction of the per-step checks; merged in a thread-independent way (max, or).
+struct StepChecks {
+  double max_disp2 = 0.0;        // m^2, largest squared displacement since the last rebuild
+  bool non_finite = false;
+  double worst_overlap = 0.0;    // overlap / smaller radius
+  std::uint64_t worst_key = 0;   // (i << 32 | j) of that contact; j = kWallBit | wall for walls
+};
+constexpr std::uint64_t kWallBit = 1ull << 31;
+
+void mergeWorst(StepChecks& into, double ratio, std::uint64_t key) {
+  if (ratio > into.worst_overlap || (ratio == into.worst_overlap && ratio > 0 && key < into.worst_key)) {
+    into.worst_overlap = ratio;
+    into.worst_key = key;
+  }
+}
+
+std::string fmtNum(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
+
+}  // namespace
+
+struct World::Impl {
+  Model model;
+  ParticleState p;
+  int threads = 1;
+  double time = 0.0;
+  std::uint64_t step = 0;
+  double dt = 0.0;
+  bool half_kick_pending = true;
+  Vec3 gravity = Vec3::Zero();
+  TimestepAudit audit;
+  WorldStats stats;
+  double skin = 0.0;
+
+  // Material-pair constants: ball_ball[a * nm + b], ball_wall[ball * nm + wall].
+  std::vector<PairProps> ball_ball, ball_wall;
+  std::size_t nm = 0;
+  std::vector<detail::WallRuntime> walls;
+
+  // Ball–ball pairs (canonical CSR) and their per-pair data.
+  detail::NeighborFinder finder;
+  detail::PairList pairs;
+  std::vector<Vec3> pair_shear;      // [pairs] N, shear spring force on i (history)
+  std::vector<std::uint8_t> pair_touch;  // [pairs] 1 when touching at this step
+  std::vector<Vec3> pair_force_j;    // [pairs] N, force on j
+  std::vector<Vec3> pair_torque_j;   // [pairs] N m, torque on j
+  // Ball–wall candidates in rows by ball.
+  std::vector<std::uint32_t> wall_offset;  // [n+1]
+  std::vector<std::uint32_t> wall_index;   // [k]
+  std::vector<Vec3> wall_shear;            // [k] N on the ball
+  std::vector<std::uint8_t> wall_touch;    // [k]
+  // Per-ball accumulators of stage 3 (own-row pairs and walls).
+  std::vector<Vec3> acc_force, acc_torque;
+  // Observation buffers (filled only on observed steps).
+  std::vector<Vec3> obs_force, obs_torque, obs_velocity, obs_omega;
+  // Skin bookkeeping.
+  std::vector<Vec3> ref_position;
+  bool need_rebuild = true;
+  double last_max_disp2 = 0.0;
+  // Watchdog energy reference.
+  bool energy_ref_valid = false;
+  double energy_ref = 0.0, energy_scale = 0.0;
+  StepChecks checks;
+
+  // Below this many balls a step is a few tens of microseconds and the fork/join
+  // of a second thread costs more than it saves (measured: 1500 balls ran at half
+  // speed on 2 threads), so small worlds step on one thread. Results are bitwise
+  // the same either way.
+  static constexpr std::size_t kMinBallsPerThread = 2500;
+  int teamSize() const {
+    const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
+    return std::max(1, std::min(threads, useful));
+  }
+  void initialise(int requested_threads);
+  void buildPairProps();
+  void prepareStage();
+  void rebuildNeighbours();
+  template <class Law> void contactStage();
+  void gather(std::size_t i, Vec3& f, Vec3& t) const;
+  void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
+  template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
+  Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
+  void checkOverlap() const;
+  void checkFinite() const;
+  void checkEnergy(const Energy& e);
+  bool energyCheckApplies() const;
+  std::string stepAdvice() const;
+  void doStep(const std::function<void(const Snapshot&)>& observer);
+};
+
+// ---------------------------------------------------------------------------
+// Set-up
+
+std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres) {
+  std::ostringstream e;
+  if (model.materials.empty()) return "no materials defined";
+  for (std::size_t k = 0; k < model.materials.size(); ++k) {
+    const Material& m = model.materials[k];
+    const std::string where = "material '" + m.name + "'";
+    if (!(m.density > 0)) return where + ": density must be > 0 kg/m^3";
+    if (!(m.friction >= 0)) return where + ": friction must be >= 0";
+    if (model.contact.law == ContactLaw::Linear && !(m.kn > 0 && m.ks >= 0))
+      return where + ": the linear law needs kn > 0 and ks >= 0 N/m";
+    if (model.contact.law == ContactLaw::HertzMindlin &&
+        !(m.shear_modulus > 0 && m.poisson > -1 && m.poisson < 0.5))
+      return where + ": Hertz–Mindlin needs shear_modulus > 0 Pa and -1 < poisson < 0.5";
+  }
+  const auto nm = static_cast<int>(model.materials.size());
+  for (const Wall& w : model.walls) {
+    const std::string where = "wall '" + w.name + "'";
+    if (w.material < 0 || w.material >= nm) return where + ": unknown material";
+    if (w.shape == WallShape::Plane) {
+      if (!(w.normal.norm() > 0)) return where + ": normal must not be zero";
+      if (!w.motion.angular_velocity.isZero(0))
+        return where + ": an infinite plane cannot rotate; use a polygon";
+    }
+    if (w.shape == WallShape::Polygon) {
+      if (w.vertices.size() < 3) return where + ": a polygon needs at least 3 vertices";
+      const Vec3 nrm = (w.vertices[1] - w.vertices[0]).cross(w.vertices[2] - w.vertices[0]);
+      if (!(nrm.norm() > 0)) return where + ": the first three vertices are collinear";
+      const double scale = (w.vertices[1] - w.vertices[0]).norm();
+      for (const Vec3& v : w.vertices)
+        if (std::abs((v - w.vertices[0]).dot(nrm.normalized())) > 1e-9 * std::max(1.0, scale))
+          return where + ": the vertices are not in one plane";
+    }
+    if (w.shape == WallShape::Mesh) {
+      const std::string msg = w.mesh.validate();
+      if (!msg.empty()) return where + ": " + msg;
+    }
+    if (!(w.active_until > w.active_from)) return where + ": active_until must be after active_from";
+  }
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    const SphereSpec& s = spheres[i];
+    if (!(s.radius > 0)) {
+      e << "sphere " << i << ": radius must be > 0 m";
+      return e.str();
+    }
+    if (s.material < 0 || s.material >= nm) {
+      e << "sphere " << i << ": unknown material index " << s.material;
+      return e.str();
+    }
+    if (!s.position.allFinite() || !s.velocity.allFinite() || !s.omega.allFinite()) {
+      e << "sphere " << i << ": position, velocity and omega must be finite";
+      return e.str();
+    }
+  }
+  return {};
+}
+
+World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
+    : impl_(std::make_unique<Impl>()) {
+  const std::string msg = validateModel(model, spheres);
+  if (!msg.empty()) throw std::invalid_argument(msg);
+  Impl& w = *impl_;
+  w.model = std::move(model);
+  ParticleState& p = w.p;
+  const std::size_t n = spheres.size();
+  p.position.resize(n);
+  p.velocity.resize(n);
+  p.omega.resize(n);
+  p.radius.resize(n);
+  p.inv_mass.resize(n);
+  p.inv_inertia.resize(n);
+  p.material.resize(n);
+  p.mass.resize(n);
+  p.id.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SphereSpec& s = spheres[i];
+    const double r = s.radius;
+    const double m = w.model.materials[s.material].density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    p.position[i] = s.position;
+    p.velocity[i] = s.velocity;  // at t = 0; the first kick is a half kick
+    p.omega[i] = s.omega;
+    p.radius[i] = r;
+    p.mass[i] = m;
+    p.inv_mass[i] = 1.0 / m;
+    p.inv_inertia[i] = 1.0 / (0.4 * m * r * r);  // Eq 2-8
+    p.material[i] = s.material;
+    p.id[i] = i;
+  }
+  w.audit = auditTimestep(w.model, p);
+  w.dt = w.audit.chosen;
+  w.initialise(threads);
+}
+
+World::World(Model model, WorldState state, int threads) : impl_(std::make_unique<Impl>()) {
+  Impl& w = *impl_;
+  w.model = std::move(model);
+  const std::string msg = validateModel(w.model, {});
+  if (!msg.empty()) throw std::invalid_argument(msg);
+  w.p = std::move(state.particles);
+  w.time = state.time;
+  w.step = state.step;
+  w.half_kick_pending = state.half_kick_pending;
+  w.audit = auditTimestep(w.model, w.p);
+  w.audit.chosen = state.dt;  // the run continues with the step it had
+  w.dt = state.dt;
+  w.initialise(threads);
+  // Contact history: build the lists now and take the saved shear forces.
+  w.prepareStage();
+  w.rebuildNeighbours();
+  for (const PairHistory& h : state.pair_history) {
+    const auto b = w.pairs.partner.begin() + w.pairs.row_offset[h.i];
+    const auto e = w.pairs.partner.begin() + w.pairs.row_offset[h.i + 1];
+    const auto it = std::lower_bound(b, e, h.j);
+    if (it == e || *it != h.j)
+      throw std::invalid_argument("checkpoint: contact history for a pair that is not in contact range");
+    w.pair_shear[it - w.pairs.partner.begin()] = h.shear;
+  }
+  for (const WallHistory& h : state.wall_history) {
+    bool found = false;
+    for (std::uint32_t c = w.wall_offset[h.particle]; c < w.wall_offset[h.particle + 1]; ++c)
+      if (w.wall_index[c] == h.wall) {
+        w.wall_shear[c] = h.shear;
+        found = true;
+      }
+    if (!found)
+      throw std::invalid_argument("checkpoint: wall contact history for a ball out of wall range");
+  }
+}
+
+World::~World() = default;
+
+void World::Impl::initialise(int requested_threads) {
+  threads = requested_threads > 0 ? requested_threads : omp_get_max_threads();
+  buildPairProps();
+  walls.resize(model.walls.size());
+  for (std::size_t k = 0; k < walls.size(); ++k) walls[k].setup(model.walls[k]);
+  // Gravity in force at the current time.
+  gravity = model.gravity;
+  for (const GravityChange& g : model.gravity_changes)
+    if (g.time <= time) gravity = g.vector;
+  if (model.skin > 0) {
+    skin = model.skin;
+  } else {
+    double sum = 0;
+    for (double r : p.radius) sum += r;
+    skin = p.size() ? 0.2 * sum / static_cast<double>(p.size()) : 1e-3;
+  }
+  const std::size_t n = p.size();
+  acc_force.assign(n, Vec3::Zero());
+  acc_torque.assign(n, Vec3::Zero());
+  need_rebuild = true;
+}
+
+void World::Impl::buildPairProps() {
+  nm = model.materials.size();
+  ball_ball.resize(nm * nm);
+  ball_wall.resize(nm * nm);
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = 0; b < nm; ++b) {
+      ball_ball[a * nm + b] = detail::ballBallProps(model.materials[a], model.materials[b]);
+      ball_wall[a * nm + b] = detail::ballWallProps(model.materials[a], model.materials[b]);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Stage 1: prepare (gravity schedule, wall poses)
+
+void World::Impl::prepareStage() {
+  for (const GravityChange& g : model.gravity_changes) {
+    if (g.time <= time && g.time > time - dt && gravity != g.vector) {
+      gravity = g.vector;
+      energy_ref_valid = false;  // gravity did work on the system: new reference
+    }
+  }
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const bool was_active = walls[k].active;
+    walls[k].update(model.walls[k], time);
+    if (walls[k].active && !was_active) need_rebuild = true;
+    if (walls[k].active != was_active) energy_ref_valid = false;
+    if (walls[k].displacementSinceReference() > 0.5 * skin) need_rebuild = true;
+  }
+  if (last_max_disp2 > 0.25 * skin * skin) need_rebuild = true;
+}
+
+// ---------------------------------------------------------------------------
+// Stage 2: neighbours (with contact history carried over)
+
+void World::Impl::rebuildNeighbours() {
+  const std::size_t n = p.size();
+  detail::PairList old = std::move(pairs);
+  std::vector<Vec3> old_shear = std::move(pair_shear);
+  finder.build(p.position, p.radius, skin, teamSize(), pairs);
+  const std::size_t np = pairs.size();
+  pair_shear.assign(np, Vec3::Zero());
+  pair_touch.assign(np, 0);
+  pair_force_j.resize(np);
+  pair_torque_j.resize(np);
+  // Carry shear history over by merging old and new rows (both sorted by j).
+  if (!old.row_offset.empty()) {
+#pragma omp parallel for schedule(static) num_threads(teamSize())
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint32_t a = old.row_offset[i], b = pairs.row_offset[i];
+      const std::uint32_t ae = old.row_offset[i + 1], be = pairs.row_offset[i + 1];
+      while (a < ae && b < be) {
+        if (old.partner[a] < pairs.partner[b]) ++a;
+        else if (old.partner[a] > pairs.partner[b]) ++b;
+        else pair_shear[b++] = old_shear[a++];
+      }
+    }
+  }
+  // Wall candidates: balls within r + skin of an active wall.
+  std::vector<std::uint32_t> old_offset = std::move(wall_offset), old_index = std::move(wall_index);
+  std::vector<Vec3> old_wshear = std::move(wall_shear);
+  wall_offset.assign(n + 1, 0);
+  wall_index.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < walls.size(); ++k) {
+      if (!walls[k].active) continue;
+      if (walls[k].distance(model.walls[k], p.position[i]) < p.radius[i] + skin)
+        wall_index.push_back(static_cast<std::uint32_t>(k));
+    }
+    wall_offset[i + 1] = static_cast<std::uint32_t>(wall_index.size());
+  }
+  wall_shear.assign(wall_index.size(), Vec3::Zero());
+  wall_touch.assign(wall_index.size(), 0);
+  if (!old_offset.empty()) {
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c)
+        for (std::uint32_t o = old_offset[i]; o < old_offset[i + 1]; ++o)
+          if (old_index[o] == wall_index[c]) wall_shear[c] = old_wshear[o];
+  }
+  ref_position = p.position;
+  for (auto& wr : walls) wr.setReference();
+  last_max_disp2 = 0.0;
+  need_rebuild = false;
+  ++stats.neighbour_rebuilds;
+  stats.pairs_in_list = np;
+  stats.wall_candidates = wall_index.size();
+}
+
+// ---------------------------------------------------------------------------
+// Stage 3: contacts
+
+template <class Law>
+void World::Impl::contactStage() {
+  const std::size_t n = p.size();
+  const ContactModel& cm = model.contact;
+  const bool average_mass = cm.damping_mass == DampingMass::Average;
+  const double overlap_limit = model.watchdog.max_overlap_fraction;
+  const double h = dt;
+  StepChecks merged;
+#pragma omp parallel num_threads(teamSize())
+  {
+    StepChecks local;
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 xi = p.position[i], vi = p.velocity[i], wi = p.omega[i];
+      const double ri = p.radius[i], mi = p.mass[i];
+      const std::size_t mat_i = static_cast<std::size_t>(p.material[i]);
+      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
+      // Ball–ball pairs in which i is the first ball.
+      for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
+        const std::uint32_t j = pairs.partner[k];
+        const Vec3 d = p.position[j] - xi;
+        const double rj = p.radius[j];
+        const double rsum = ri + rj;
+        const double dist2 = d.squaredNorm();
+        if (dist2 >= rsum * rsum) {
+          pair_touch[k] = 0;
+          pair_shear[k].setZero();
+          continue;
+        }
+        const double dist = std::sqrt(dist2);
+        detail::ContactGeometry g;
+        g.normal = dist > 0 ? Vec3(d / dist) : Vec3(Vec3::UnitZ());
+        g.overlap = rsum - dist;
+        const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point
+        const Vec3 ai = cp - xi, aj = cp - p.position[j];
+        g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (vi + wi.cross(ai));
+        g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
+        const double mj = p.mass[j];
+        g.damping_mass = average_mass ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
+        const PairProps& props = ball_ball[mat_i * nm + static_cast<std::size_t>(p.material[j])];
+        const detail::ContactResult res = detail::evaluateContact<Law>(props, cm, g, h, pair_shear[k]);
+        f += res.force;
+        t += ai.cross(res.force);
+        pair_force_j[k] = -res.force;
+        pair_torque_j[k] = aj.cross(-res.force);
+        pair_touch[k] = 1;
+        const double ratio = g.overlap / std::min(ri, rj);
+        if (ratio > overlap_limit) mergeWorst(local, ratio, (std::uint64_t(i) << 32) | j);
+      }
+      // Ball–wall contacts.
+      for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c) {
+        const std::uint32_t wk = wall_index[c];
+        const detail::WallRuntime& wr = walls[wk];
+        detail::WallContact wc;
+        if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
+          wall_touch[c] = 0;
+          wall_shear[c].setZero();
+          continue;
+        }
+        detail::ContactGeometry g;
+        g.normal = wc.normal;
+        g.overlap = wc.overlap;
+        const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
+        const Vec3 ai = cp - xi;
+        g.rel_velocity = wr.velocityAt(cp) - (vi + wi.cross(ai));
+        g.r_tilde = ri;   // mirror-image ball (ref §4.2)
+        g.damping_mass = mi;  // ball–wall dashpot uses the ball's mass (Eq 2-18)
+        const PairProps& props =
+            ball_wall[mat_i * nm + static_cast<std::size_t>(model.walls[wk].material)];
+        const detail::ContactResult res = detail::evaluateContact<Law>(props, cm, g, h, wall_shear[c]);
+        f += res.force;
+        t += ai.cross(res.force);
+        wall_touch[c] = 1;
+        const double ratio = g.overlap / ri;
+        if (ratio > overlap_limit) mergeWorst(local, ratio, (std::uint64_t(i) << 32) | kWallBit | wk);
+      }
+      acc_force[i] = f;
+      acc_torque[i] = t;
+    }
+#pragma omp critical
+    mergeWorst(merged, local.worst_overlap, local.worst_key);
+  }
+  checks.worst_overlap = merged.worst_overlap;
+  checks.worst_key = merged.worst_key;
+}
+
+// ---------------------------------------------------------------------------
+// Stages 4 and 6: gather and integrate
+
+inline void World::Impl::gather(std::size_t i, Vec3& f, Vec3& t) const {
+  // Own-row contributions first, then pairs where i is second, in ascending i:
+  // a fixed order, so the sum does not depend on threads or rebuild times.
+  f = acc_force[i];
+  t = acc_torque[i];
+  for (std::uint32_t c = pairs.col_offset[i]; c < pairs.col_offset[i + 1]; ++c) {
+    const std::uint32_t k = pairs.col_pair[c];
+    if (!pair_touch[k]) continue;
+    f += pair_force_j[k];
+    t += pair_torque_j[k];
+  }
+}
+
+inline void World::Impl::integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque,
+                                   double h, StepChecks& c) {
+  const double inv_m = p.inv_mass[i];
+  Vec3 f = f_contact + gravity / inv_m;  // generalised force incl. gravity (Eq 2-14)
+  Vec3 t = torque;
+  const double alpha = model.contact.local_damping;
+  if (alpha > 0) {
+    // Cundall's local damping, Eq 2-15 in its sign form: -alpha |F| sign(v) per component.
+    for (int a = 0; a < 3; ++a) {
+      f[a] -= alpha * std::abs(f[a]) * ((p.velocity[i][a] > 0) - (p.velocity[i][a] < 0));
+      t[a] -= alpha * std::abs(t[a]) * ((p.omega[i][a] > 0) - (p.omega[i][a] < 0));
+    }
+  }
+  p.velocity[i] += (h * inv_m) * f;               // Eq 2-11
+  p.omega[i] += (h * p.inv_inertia[i]) * t;       // Eq 2-12 (sphere: no gyroscopic term)
+  p.position[i] += dt * p.velocity[i];            // Eq 2-13
+  if (!p.position[i].allFinite() || !p.velocity[i].allFinite()) c.non_finite = true;
+  c.max_disp2 = std::max(c.max_disp2, (p.position[i] - ref_position[i]).squaredNorm());
+}
+
+// ---------------------------------------------------------------------------
+// Energy (observed steps only)
+
+template <class Law>
+Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const {
+  Energy e;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    e.kinetic_translational += 0.5 * p.mass[i] * v[i].squaredNorm();
+    e.kinetic_rotational += 0.5 / p.inv_inertia[i] * w[i].squaredNorm();
+    e.potential_gravity -= p.mass[i] * gravity.dot(p.position[i]);
+    for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
+      if (!pair_touch[k]) continue;
+      const std::uint32_t j = pairs.partner[k];
+      const double rsum = p.radius[i] + p.radius[j];
+      const double overlap = rsum - (p.position[j] - p.position[i]).norm();
+      const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm +
+                                         static_cast<std::size_t>(p.material[j])];
+      e.elastic += detail::elasticEnergy<Law>(props, overlap, 2.0 * p.radius[i] * p.radius[j] / rsum,
+                                              pair_shear[k]);
+    }
+    for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c) {
+      if (!wall_touch[c]) continue;
+      const std::uint32_t wk = wall_index[c];
+      detail::WallContact wc;
+      if (!walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc)) continue;
+      const PairProps& props = ball_wall[static_cast<std::size_t>(p.material[i]) * nm +
+                                         static_cast<std::size_t>(model.walls[wk].material)];
+      e.elastic += detail::elasticEnergy<Law>(props, wc.overlap, p.radius[i], wall_shear[c]);
+    }
+  }
+  return e;
+}
+
+Energy World::Impl::energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const {
+  return model.contact.law == ContactLaw::Linear ? energy<detail::LinearLaw>(v, w)
+                                                 : energy<detail::HertzMindlinLaw>(v, w);
+}
+
+// ---------------------------------------------------------------------------
+// Stage 7: watchdog
+
+std::string World::Impl::stepAdvice() const {
+  std::ostringstream s;
+  s << "The step dt = " << fmtNum(dt) << " s is " << fmtNum(dt / audit.critical)
+    << " x the critical step " << fmtNum(audit.critical) << " s";
+  if (model.timestep.dt > 0)
+    s << " (set by timestep.dt); lower timestep.dt";
+  else
+    s << "; lower timestep.safety_factor (now " << model.timestep.safety_factor << ")";
+  s << ", or soften the contacts (materials kn/ks or shear_modulus).";
+  return s.str();
+}
+
+void World::Impl::checkOverlap() const {
+  if (checks.worst_overlap <= model.watchdog.max_overlap_fraction) return;
+  const auto i = static_cast<std::size_t>(checks.worst_key >> 32);
+  const auto low = static_cast<std::uint32_t>(checks.worst_key & 0xffffffffu);
+  std::ostringstream s;
+  s << "watchdog: at t = " << fmtNum(time) << " s (step " << step << ") the overlap of particle "
+    << p.id[i];
+  if (low & kWallBit)
+    s << " with wall '" << model.walls[low & ~kWallBit].name << "'";
+  else
+    s << " with particle " << p.id[low];
+  s << " is " << fmtNum(checks.worst_overlap)
+    << " of the smaller radius, above watchdog.max_overlap_fraction = "
+    << model.watchdog.max_overlap_fraction << ". Either the particles were created overlapping, or "
+    << stepAdvice();
+  throw WatchdogError(s.str());
+}
+
+void World::Impl::checkFinite() const {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.position[i].allFinite() && p.velocity[i].allFinite()) continue;
+    std::ostringstream s;
+    s << "watchdog: particle " << p.id[i] << " has a non-finite position or velocity at t = "
+      << fmtNum(time) << " s (step " << step << "): the run blew up. " << stepAdvice();
+    throw WatchdogError(s.str());
+  }
+}
+
+bool World::Impl::energyCheckApplies() const {
+  // With a moving wall, work comes in from outside: the check cannot tell.
+  for (std::size_t k = 0; k < walls.size(); ++k)
+    if (walls[k].active && !model.walls[k].motion.isStatic()) return false;
+  return model.watchdog.max_energy_growth > 0 && p.size() > 0;
+}
+
+void World::Impl::checkEnergy(const Energy& e) {
+  if (!energyCheckApplies()) return;
+  if (!energy_ref_valid) {
+    // Scale: the energy the system could release by falling across its own extent.
+    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+    double mass = 0, r_max = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      lo = lo.cwiseMin(p.position[i]);
+      hi = hi.cwiseMax(p.position[i]);
+      mass += p.mass[i];
+      r_max = std::max(r_max, p.radius[i]);
+    }
+    const double extent = (hi - lo).norm() + 2 * r_max;
+    energy_ref = e.total();
+    energy_scale = std::abs(e.kinetic_translational + e.kinetic_rotational + e.elastic) +
+                   mass * gravity.norm() * extent;
+    energy_ref_valid = energy_scale > 0;
+    return;
+  }
+  const double growth = e.total() - energy_ref;
+  if (growth <= model.watchdog.max_energy_growth * energy_scale) return;
+  std::size_t fastest = 0;
+  for (std::size_t i = 1; i < p.size(); ++i)
+    if (p.velocity[i].squaredNorm() > p.velocity[fastest].squaredNorm()) fastest = i;
+  std::ostringstream s;
+  s << "watchdog: mechanical energy grew by " << fmtNum(growth) << " J (" << fmtNum(growth / energy_scale)
+    << " of its scale " << fmtNum(energy_scale) << " J, limit watchdog.max_energy_growth = "
+    << model.watchdog.max_energy_growth << ") at t = " << fmtNum(time) << " s (step " << step
+    << ") with no work input; fastest particle " << p.id[fastest] << " at "
+    << fmtNum(p.velocity[fastest].norm()) << " m/s. " << stepAdvice();
+  throw WatchdogError(s.str());
+}
+
+// ---------------------------------------------------------------------------
+// One step
+
+void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
+  const std::size_t n = p.size();
+  prepareStage();                                     // 1
+  if (need_rebuild) rebuildNeighbours();              // 2
+  if (model.contact.law == ContactLaw::Linear)        // 3
+    contactStage<detail::LinearLaw>();
+  else
+    contactStage<detail::HertzMindlinLaw>();
+  checkOverlap();
+
+  const double h = half_kick_pending ? 0.5 * dt : dt;
+  const int interval = std::max(1, model.watchdog.check_interval);
+  const bool energy_due = (step % static_cast<std::uint64_t>(interval)) == 0 && energyCheckApplies();
+  StepChecks merged;
+  if (!observer && !energy_due) {
+    // 4 + 6 fused: gather and integrate in one pass.
+#pragma omp parallel num_threads(teamSize())
+    {
+      StepChecks local;
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        Vec3 f, t;
+        gather(i, f, t);
+        integrate(i, f, t, h, local);
+      }
+#pragma omp critical
+      {
+        merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
+        merged.non_finite = merged.non_finite || local.non_finite;
+      }
+    }
+  } else {
+    // 4, 5, 6 apart: the snapshot needs the whole-step state before the kick.
+    obs_force.resize(n);
+    obs_torque.resize(n);
+    obs_velocity.resize(n);
+    obs_omega.resize(n);
+#pragma omp parallel for schedule(static) num_threads(teamSize())
+    for (std::size_t i = 0; i < n; ++i) {
+      gather(i, obs_force[i], obs_torque[i]);
+      // v(t) = v(t - dt/2) + a(t) dt/2; at the first step v holds v(0) already.
+      const double half = half_kick_pending ? 0.0 : 0.5 * dt;
+      obs_velocity[i] = p.velocity[i] + half * (obs_force[i] * p.inv_mass[i] + gravity);
+      obs_omega[i] = p.omega[i] + half * p.inv_inertia[i] * obs_torque[i];
+    }
+    Snapshot s;
+    s.time = time;
+    s.step = step;
+    s.energy = energyAny(obs_velocity, obs_omega);
+    if (energy_due) checkEnergy(s.energy);
+    if (observer) {
+      // Report total force including gravity.
+      std::vector<Vec3> total(n);
+      for (std::size_t i = 0; i < n; ++i) total[i] = obs_force[i] + gravity * p.mass[i];
+      s.position = p.position;
+      s.velocity = obs_velocity;
+      s.omega = obs_omega;
+      s.force = total;
+      s.radius = p.radius;
+      s.id = p.id;
+      for (std::uint8_t t : pair_touch) s.contacts += t;
+      for (std::uint8_t t : wall_touch) s.wall_contacts += t;
+      s.max_overlap_fraction = checks.worst_overlap;
+      observer(s);
+    }
+#pragma omp parallel num_threads(teamSize())
+    {
+      StepChecks local;
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) integrate(i, obs_force[i], obs_torque[i], h, local);
+#pragma omp critical
+      {
+        merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
+        merged.non_finite = merged.non_finite || local.non_finite;
+      }
+    }
+  }
+  half_kick_pending = false;
+  time = static_cast<double>(step + 1) * dt;  // no accumulated round-off in t
+  ++step;
+  last_max_disp2 = merged.max_disp2;
+  if (merged.non_finite) checkFinite();  // 7
+}
+
+void World::step(const std::function<void(const Snapshot&)>& observer) { impl_->doStep(observer); }
+
+double World::time() const { return impl_->time; }
+std::uint64_t World::stepCount() const { return impl_->step; }
+double World::dt() const { return impl_->dt; }
+const Model& World::model() const { return impl_->model; }
+const ParticleState& World::particles() const { return impl_->p; }
+const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
+const WorldStats& World::stats() const { return impl_->stats; }
+int World::threads() const { return impl_->threads; }
+Vec3 World::gravity() const { return impl_->gravity; }
+
+WorldState World::exportState() const {
+  const Impl& w = *impl_;
+  WorldState s;
+  s.time = w.time;
+  s.step = w.step;
+  s.dt = w.dt;
+  s.half_kick_pending = w.half_kick_pending;
+  s.particles = w.p;
+  for (std::size_t i = 0; i + 1 < w.pairs.row_offset.size(); ++i)
+    for (std::uint32_t k = w.pairs.row_offset[i]; k < w.pairs.row_offset[i + 1]; ++k)
+      if (!w.pair_shear[k].isZero(0))
+        s.pair_history.push_back({static_cast<std::uint32_t>(i), w.pairs.partner[k], w.pair_shear[k]});
+  for (std::size_t i = 0; i + 1 < w.wall_offset.size(); ++i)
+    for (std::uint32_t c = w.wall_offset[i]; c < w.wall_offset[i + 1]; ++c)
+      if (!w.wall_shear[c].isZero(0))
+        s.wall_history.push_back({static_cast<std::uint32_t>(i), w.wall_index[c], w.wall_shear[c]});
+  return s;
+}
+
+std::uint64_t World::stateHash() const {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+  auto mix = [&h](const std::vector<Vec3>& a) {
+    const auto* bytes = reinterpret_cast<const unsigned char*>(a.data());
+    for (std::size_t k = 0; k < a.size() * sizeof(Vec3); ++k) {
+      h ^= bytes[k];
+      h *= 1099511628211ull;
+    }
+  };
+  mix(impl_->p.position);
+  mix(impl_->p.velocity);
+  mix(impl_->p.omega);
+  return h;
+}
+
+}  // namespace rocklab::sim

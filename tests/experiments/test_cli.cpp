@@ -1,0 +1,75 @@
+// The CLI in-process: exit codes, outputs, and "bad input loses nothing".
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "rocklab/experiments/cli.h"
+
+namespace fs = std::filesystem;
+using rocklab::experiments::runCli;
+
+namespace {
+int cli(std::vector<std::string> args) {
+  args.insert(args.begin(), "rocklab");
+  std::vector<const char*> argv;
+  for (auto& a : args) argv.push_back(a.c_str());
+  return runCli(static_cast<int>(argv.size()), argv.data());
+}
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name);
+  fs::remove_all(d);
+  return d;
+}
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+const std::string kScene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/demo.toml";
+}  // namespace
+
+TEST_CASE("help and usage errors", "[cli]") {
+  CHECK(cli({"--help"}) == 0);
+  CHECK(cli({}) == 2);
+  CHECK(cli({"run"}) == 2);
+  CHECK(cli({"frobnicate"}) == 2);
+}
+
+TEST_CASE("a short run writes run.h5 - checkpoint - vtk and results.json", "[cli]") {
+  const fs::path out = tempDir("run");
+  REQUIRE(cli({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=0.002", "--set",
+               "particles.0.count=200", "--set", "output.frame_interval=0.001"}) == 0);
+  for (const char* f : {"run.h5", "checkpoint.h5", "results.json", "vtk/particles.pvd"}) CHECK(fs::exists(out / f));
+  const auto r = nlohmann::json::parse(slurp(out / "results.json"));
+  CHECK(r["status"] == "completed");
+  CHECK(r["particles"] == 200);
+  CHECK(r["outputs"]["frames"] == 3);  // t = 0, 0.001 and the last step
+  CHECK(r["wall_time_s"]["stepping"].get<double>() > 0);
+
+  // Restart from the checkpoint continues to a later end time.
+  const fs::path out2 = tempDir("restart");
+  REQUIRE(cli({"restart", (out / "checkpoint.h5").string(), "--out", out2.string(), "--quiet", "--set",
+               "scene.end_time=0.003"}) == 0);
+  const auto r2 = nlohmann::json::parse(slurp(out2 / "results.json"));
+  CHECK(r2["simulated_time_s"].get<double>() == Approx(0.003).margin(2e-6));
+  fs::remove_all(out);
+  fs::remove_all(out2);
+}
+
+TEST_CASE("bad input: exit code 2 and the previous outputs are untouched", "[cli]") {
+  const fs::path out = tempDir("bad");
+  fs::create_directories(out);
+  std::ofstream(out / "results.json") << "{\"previous\": true}\n";
+  CHECK(cli({"run", kScene, "--out", out.string(), "--set", "timestep.safety_factor=7"}) == 2);
+  CHECK(cli({"run", kScene, "--out", out.string(), "--set", "timestep.dt=1"}) == 2);
+  CHECK(cli({"run", "/no/such/scene.toml", "--out", out.string()}) == 2);
+  CHECK(cli({"restart", "/no/such/checkpoint.h5", "--out", out.string()}) == 2);
+  CHECK(slurp(out / "results.json") == "{\"previous\": true}\n");
+  CHECK(!fs::exists(out / "run.h5"));
+  fs::remove_all(out);
+}
+
+TEST_CASE("check and list", "[cli]") {
+  CHECK(cli({"check", kScene}) == 0);
+  CHECK(cli({"list"}) == 0);
+}

@@ -1,0 +1,99 @@
+// Scene files: every class of bad input gives one message naming file, line,
+// key, value and what is allowed; built-in scenes load.
+#include <catch2/catch.hpp>
+#include <filesystem>
+
+#include "rocklab/experiments/scene.h"
+
+using namespace rocklab::experiments;
+using Catch::Contains;
+
+namespace {
+const std::string kMinimal = R"(
+[scene]
+name = "t"
+end_time = 0.01
+
+[materials.rock]
+density = 2730
+kn = 1e7
+
+[[particles]]
+type = "list"
+material = "rock"
+radius = 0.01
+positions = [[0, 0, 0.1]]
+)";
+
+std::string errorOf(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    loadSceneText(text, "bad.toml", overrides);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST_CASE("a minimal scene loads with defaults", "[scene]") {
+  const Scene s = loadSceneText(kMinimal, "min.toml");
+  CHECK(s.spheres.size() == 1);
+  CHECK(s.model.materials[0].ks == 1e7);  // ks defaults to kn
+  CHECK(s.model.gravity.z() == -9.81);
+  CHECK(s.run.end_time == 0.01);
+}
+
+TEST_CASE("unknown key: file - line and the known keys", "[scene]") {
+  const std::string msg = errorOf(kMinimal + "\n[timestep]\nsaftey_factor = 0.3\n");
+  CHECK_THAT(msg, Contains("bad.toml:17: unknown key 'timestep.saftey_factor'") && Contains("safety_factor"));
+}
+
+TEST_CASE("wrong type: names the key - the value and the allowed values", "[scene]") {
+  CHECK_THAT(errorOf(kMinimal + "\n[timestep]\nsafety_factor = \"fast\"\n"),
+             Contains("bad.toml:17: key 'timestep.safety_factor' = \"fast\": expected a number") && Contains("(0, 1]"));
+  CHECK_THAT(errorOf(kMinimal + "\n[contact]\nlaw = \"hooke\"\n"),
+             Contains("key 'contact.law' = \"hooke\": not allowed; allowed: \"linear\", \"hertz_mindlin\""));
+}
+
+TEST_CASE("out of range values are refused with the range", "[scene]") {
+  CHECK_THAT(errorOf(kMinimal + "\n[contact]\ndamping_normal = 1.5\n"),
+             Contains("key 'contact.damping_normal' = 1.5: out of range; allowed: [0, 1)"));
+  CHECK_THAT(errorOf(kMinimal, {"materials.rock.density=-3"}),
+             Contains("--set materials.rock.density=-3: key 'materials.rock.density' = -3: out of range; allowed: > 0"));
+}
+
+TEST_CASE("missing pieces and files", "[scene]") {
+  CHECK_THAT(errorOf("[scene]\nname = \"x\"\nend_time = 1\n"), Contains("key 'materials'") && Contains("missing"));
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"plane\"\nmaterial = \"rock\"\nnormal = [0,0,1]\n"),
+             Contains("key 'walls.0.point'") && Contains("missing"));
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"steel\"\n"),
+             Contains("key 'walls.0.material' = \"steel\": not allowed; allowed: \"rock\""));
+  try {
+    loadScene("/nonexistent/scene.toml");
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("/nonexistent/scene.toml: cannot open the scene file"));
+  }
+  CHECK_THAT(errorOf("[scene\nname = 1"), Contains("bad.toml:1: TOML syntax error"));
+}
+
+TEST_CASE("option set overrides: values - array indices and bad paths", "[scene]") {
+  const Scene s = loadSceneText(kMinimal, "t.toml", {"particles.0.radius=0.02", "scene.end_time=2", "gravity.vector=[0,0,-1]"});
+  CHECK(s.spheres[0].radius == 0.02);
+  CHECK(s.run.end_time == 2.0);
+  CHECK(s.model.gravity.z() == -1.0);
+  CHECK_THAT(s.text, Contains("end_time = 2"));  // the effective scene is what gets stored
+  CHECK_THAT(errorOf(kMinimal, {"particles.3.radius=1"}), Contains("index 3 is beyond the 1 entries"));
+  CHECK_THAT(errorOf(kMinimal, {"noequals"}), Contains("expected key=value"));
+}
+
+TEST_CASE("every built-in scene loads", "[scene]") {
+  int count = 0;
+  for (const auto& e : std::filesystem::directory_iterator(builtinSceneDir())) {
+    if (e.path().extension() != ".toml") continue;
+    INFO(e.path());
+    CHECK_NOTHROW(loadScene(e.path()));
+    ++count;
+  }
+  CHECK(count >= 1);
+}

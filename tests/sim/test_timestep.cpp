@@ -1,0 +1,56 @@
+// The time-step formulas of the audit, each against an independent value.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+
+#include "rocklab/sim/timestep.h"
+#include "support.h"
+
+using namespace rocklab;
+using Catch::Matchers::WithinRel;
+
+TEST_CASE("restitution <-> damping ratio (Eq 4-4) and the study's numbers", "[timestep]") {
+  CHECK_THAT(sim::restitutionFromDamping(0.0), WithinRel(1.0, 1e-15));
+  for (double beta : {0.05, 0.11, 0.3, 0.7})
+    CHECK_THAT(sim::dampingFromRestitution(sim::restitutionFromDamping(beta)), WithinRel(beta, 1e-12));
+  // Reference §6.3: e = 0.72 gives beta = 0.104; beta = 0.11 gives e = 0.706.
+  CHECK(sim::dampingFromRestitution(0.72) == Approx(0.104).margin(5e-4));
+  CHECK(sim::restitutionFromDamping(0.11) == Approx(0.706).margin(5e-4));
+}
+
+TEST_CASE("spring - Rayleigh and contact-time formulas", "[timestep]") {
+  const double m = 0.0114, r = 0.01, k = 1e9;
+  const double inertia = 0.4 * m * r * r;
+  CHECK_THAT(sim::springCriticalStep(m, inertia, r, k, 2 * k), WithinRel(std::sqrt(0.4 * m / (2 * k)), 1e-14));
+  CHECK_THAT(sim::springCriticalStep(m, inertia, r, k, 0.1 * k), WithinRel(std::sqrt(m / k), 1e-14));
+  // Rayleigh: for nu = 0.25 the Rayleigh speed is 0.9194 c_s (Viktorov).
+  const double rho = 2700, g = 30e9, nu = 0.25;
+  const double expected = std::numbers::pi * r / (0.9194 * std::sqrt(g / rho));
+  CHECK_THAT(sim::rayleighStep(r, rho, g, nu), WithinRel(expected, 5e-3));  // the fit is 0.2 % off here
+  // Linear contact time: half a damped period.
+  CHECK_THAT(sim::linearContactTime(m, k, 0.0), WithinRel(std::numbers::pi * std::sqrt(m / k), 1e-14));
+  // Hertz with the study's law reduces to classical Hertz for equal spheres:
+  // c = (4/3) E* sqrt(R*), E* = G / (1 - nu), R* = R/2 (reference §4.2 check).
+  const double c = sim::hertzCoefficient(g, nu, r);
+  CHECK_THAT(c, WithinRel(4.0 / 3.0 * g / (1 - nu) * std::sqrt(r / 2), 1e-14));
+  // Classical Hertz time 2.868 (m*^2 / (R* E*^2 v))^(1/5) (Johnson, Contact Mechanics §11.4).
+  const double v = 2.0, m_star = m / 2, e_star = g / (1 - nu);
+  const double classical = 2.868 * std::pow(m_star * m_star / (r / 2 * e_star * e_star * v), 0.2);
+  CHECK_THAT(sim::hertzContactTime(m_star, c, v), WithinRel(classical, 2e-3));
+}
+
+TEST_CASE("audit: automatic step - scene may only lower it", "[timestep]") {
+  auto model = test::linearModel(2e9);
+  model.walls.push_back(test::floorPlane());
+  std::vector<sim::SphereSpec> s{test::sphere({0, 0, 0.02}, 0.01)};
+  sim::World w(model, s, 1);
+  const double m = 2730 * 4.0 / 3.0 * std::numbers::pi * 1e-6;
+  // Stiffest partner: 2e9 in series with 2e9 = 1e9 N/m; rotation limits.
+  CHECK_THAT(w.timestepAudit().critical, WithinRel(std::sqrt(0.4 * m / 1e9), 1e-12));
+  CHECK_THAT(w.dt(), WithinRel(0.5 * w.timestepAudit().critical, 1e-12));
+
+  model.timestep.dt = 1e-3;
+  CHECK_THROWS_WITH(sim::World(model, s, 1), Catch::Contains("timestep.dt = 0.001 s is larger than the automatic step"));
+  model.timestep.allow_unsafe = true;
+  CHECK(sim::World(model, s, 1).dt() == 1e-3);
+}
