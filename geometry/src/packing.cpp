@@ -17,10 +17,13 @@ std::vector<Vec3> latticePoints(LatticeKind kind, double cell, const Vec3& offse
   std::vector<Vec3> points;
   points.reserve(basis.size() * counts[0] * counts[1] * counts[2]);
   // z outermost, so that index order is layer by layer like LIGGGHTS create_atoms.
+  // Rounded as LAMMPS' Lattice::lattice2box does, (i + b) a + a origin, so that
+  // lattices whose neighbours touch "to within rounding" touch in the same places.
+  const Vec3 shift = offset * cell;
   for (int k = 0; k < counts[2]; ++k)
     for (int j = 0; j < counts[1]; ++j)
       for (int i = 0; i < counts[0]; ++i)
-        for (const Vec3& b : basis) points.push_back((Vec3(i, j, k) + b + offset) * cell + corner);
+        for (const Vec3& b : basis) points.push_back(((Vec3(i, j, k) + b) * cell + shift) + corner);
   return points;
 }
 

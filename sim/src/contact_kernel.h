@@ -63,7 +63,7 @@ struct HertzMindlinLaw {
 
 /// Evaluates one contact and updates its shear-force history `shear` (force on A).
 template <class Law>
-inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
+[[gnu::always_inline]] inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
                                      const ContactGeometry& g, double dt, Vec3& shear) {
   const Vec3& n = g.normal;
   double kn_secant, kn_tangent;
@@ -72,16 +72,23 @@ inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
   const double vn = g.rel_velocity.dot(n);          // < 0 while approaching
   const Vec3 vt = g.rel_velocity - vn * n;
   // Normal dashpot, Eq 2-16..2-18 with the tangent stiffness; may pull (recorded choice).
-  const double cn = 2.0 * cm.damping_normal * std::sqrt(g.damping_mass * kn_tangent);
+  const double cn =
+      cm.damping_normal > 0 ? 2.0 * cm.damping_normal * std::sqrt(g.damping_mass * kn_tangent) : 0.0;
   const double fn_total = fn_elastic - cn * vn;
 
   // Shear spring: rotate the stored force into the current tangent plane keeping
   // its magnitude ([X] note (i) of §3), then add the increment (Eq 2-3..2-5).
-  const double old_mag2 = shear.squaredNorm();
-  if (old_mag2 > 0.0) {
-    shear -= shear.dot(n) * n;
+  const double sn = shear.dot(n);
+  if (sn != 0.0) {
+    shear -= sn * n;
     const double new_mag2 = shear.squaredNorm();
-    if (new_mag2 > 0.0) shear *= std::sqrt(old_mag2 / new_mag2);
+    // Restore the magnitude: factor sqrt(1 + x), x = sn^2 / |s_t|^2. The normal
+    // turns by a tiny angle per step, so x is tiny and the series
+    // 1 + x/2 - x^2/8 is exact to round-off (error x^3/16) without a square root.
+    if (new_mag2 > 0.0) {
+      const double x = sn * sn / new_mag2;
+      shear *= x < 1e-4 ? 1.0 + x * (0.5 - 0.125 * x) : std::sqrt(1.0 + x);
+    }
   }
   const double ks = Law::shear(p, fn_elastic, g.r_tilde);
   shear += (ks * dt) * vt;  // B moving along +vt drags A along +vt
@@ -94,8 +101,8 @@ inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
     shear *= limit / std::sqrt(mag2);
     ft = shear;
   } else {
-    const double cs = 2.0 * cm.damping_shear * std::sqrt(g.damping_mass * ks);
-    ft = shear + cs * vt;
+    ft = shear;
+    if (cm.damping_shear > 0) ft += (2.0 * cm.damping_shear * std::sqrt(g.damping_mass * ks)) * vt;
   }
   return {ft - fn_total * n, fn_elastic};
 }

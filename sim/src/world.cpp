@@ -389,7 +389,7 @@ void World::Impl::contactStage() {
         }
         const double dist = std::sqrt(dist2);
         detail::ContactGeometry g;
-        g.normal = dist > 0 ? Vec3(d / dist) : Vec3(Vec3::UnitZ());
+        g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
         g.overlap = rsum - dist;
         const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point
         const Vec3 ai = cp - xi, aj = cp - p.position[j];
@@ -404,8 +404,9 @@ void World::Impl::contactStage() {
         pair_force_j[k] = -res.force;
         pair_torque_j[k] = aj.cross(-res.force);
         pair_touch[k] = 1;
-        const double ratio = g.overlap / std::min(ri, rj);
-        if (ratio > overlap_limit) mergeWorst(local, ratio, (std::uint64_t(i) << 32) | j);
+        const double r_small = std::min(ri, rj);
+        if (g.overlap > overlap_limit * r_small)
+          mergeWorst(local, g.overlap / r_small, (std::uint64_t(i) << 32) | j);
       }
       // Ball–wall contacts.
       for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c) {
@@ -431,8 +432,8 @@ void World::Impl::contactStage() {
         f += res.force;
         t += ai.cross(res.force);
         wall_touch[c] = 1;
-        const double ratio = g.overlap / ri;
-        if (ratio > overlap_limit) mergeWorst(local, ratio, (std::uint64_t(i) << 32) | kWallBit | wk);
+        if (g.overlap > overlap_limit * ri)
+          mergeWorst(local, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
       }
       acc_force[i] = f;
       acc_torque[i] = t;

@@ -11,7 +11,7 @@ namespace rocklab::geometry {
 
 enum class LatticeKind { SimpleCubic, BodyCentred, FaceCentred };
 
-/// Points (cell_index + basis + offset) * cell + corner for every cell in
+/// Points (cell_index + basis) * cell + offset * cell + corner for every cell in
 /// [0, counts) — the convention of LAMMPS/LIGGGHTS `lattice ... origin offset`.
 std::vector<Vec3> latticePoints(LatticeKind kind, double cell, const Vec3& offset, const Vec3& corner,
                                 const std::array<int, 3>& counts);
