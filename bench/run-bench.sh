@@ -3,8 +3,9 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|all] [small|full] [OUTDIR]
-#   scene  settle (contact-sparse), dense (contact-rich) or all (default)
+# Usage: bench/run-bench.sh [settle|dense|grid|all] [small|full] [OUTDIR]
+#   scene  settle (contact-sparse), dense (contact-rich), grid (7:1 size ratio:
+#          multi-level against single-level neighbour grid, rocklab only) or all (default)
 #   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
 #   OUTDIR logs and results (default: a new temporary directory)
 # Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install liggghts`.
@@ -85,3 +86,18 @@ for scene in settle dense; do
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$bpp" "$touch"
   done
 done
+
+# Neighbour grid at a 7:1 size ratio: the multi-level grid against one level whose
+# cells are sized by the largest sphere (neighbours.max_levels = 1).
+if [ "$which_scenes" = all ] || [ "$which_scenes" = grid ]; then
+  printf '\ngrid_levels,N,steps,rebuilds,neighbour_ms_per_rebuild,particle_steps_per_s\n'
+  for lv in 8 1; do
+    dir="$out/rocklab-grid-$lv"
+    "$rocklab" run "$root/bench/scenes/polydisperse.toml" --out "$dir" --threads 1 --quiet \
+      --set neighbours.max_levels=$lv >"$dir.log" 2>&1
+    rb=$(json "$dir/results.json" neighbour_rebuilds)
+    printf '%s,%s,%s,%s,%.2f,%.3g\n' "$( [ $lv = 1 ] && echo single || echo multi)" "$(json "$dir/results.json" particles)" \
+      "$(json "$dir/results.json" steps)" "$rb" "$(echo "1000 * $(json "$dir/results.json" neighbour_search_s) / $rb" | bc -l)" \
+      "$(json "$dir/results.json" particle_steps_per_s)"
+  done
+fi

@@ -272,6 +272,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   r["particle_steps_per_s"] = stepping > 0 ? world->particles().size() * steps_done / stepping : 0.0;
   r["neighbour_rebuilds"] = world->stats().neighbour_rebuilds;
   r["pairs_in_list"] = world->stats().pairs_in_list;
+  r["neighbour_search_s"] = world->stats().neighbour_seconds;
   r["last_observed"] = {{"time_s", last.time},
                         {"contacts", last.contacts},
                         {"wall_contacts", last.wall_contacts},

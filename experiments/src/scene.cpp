@@ -282,6 +282,7 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   }
   if (auto t = root.table("neighbours")) {
     model.skin = t->number("skin", 0.0, Range::nonNegative());
+    model.max_grid_levels = static_cast<int>(t->integer("max_levels", model.max_grid_levels, Range::closed(1, 8)));
     t->finish();
   }
   if (auto t = root.table("watchdog")) {

@@ -15,7 +15,7 @@ constexpr double kMaxCellsPerBall = 8.0;
 }  // namespace
 
 void NeighborFinder::build(std::span<const Vec3> position, std::span<const double> radius,
-                           double skin, int threads, PairList& out) {
+                           double skin, int threads, PairList& out, int max_levels) {
   const std::size_t n = position.size();
   out.row_offset.assign(n + 1, 0);
   out.col_offset.assign(n + 1, 0);
@@ -28,7 +28,8 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
   level_of_.resize(n);
   int level_count = 1;
   for (std::size_t i = 0; i < n; ++i) {
-    const int k = std::min(kMaxLevels - 1, static_cast<int>(std::floor(std::log2(radius[i] / r_min))));
+    const int top = std::clamp(max_levels, 1, kMaxLevels) - 1;
+    const int k = std::min(top, static_cast<int>(std::floor(std::log2(radius[i] / r_min))));
     level_of_[i] = static_cast<std::uint8_t>(k);
     level_count = std::max(level_count, k + 1);
   }

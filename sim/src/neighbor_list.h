@@ -30,7 +30,7 @@ class NeighborFinder {
  public:
   /// Rebuilds `out` for the given balls. `threads` as for OpenMP num_threads.
   void build(std::span<const Vec3> position, std::span<const double> radius, double skin,
-             int threads, PairList& out);
+             int threads, PairList& out, int max_levels = 8);
 
  private:
   struct Level {

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -303,10 +304,11 @@ void World::Impl::prepareStage() {
 // Stage 2: neighbours (with contact history carried over)
 
 void World::Impl::rebuildNeighbours() {
+  const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = p.size();
   detail::PairList old = std::move(pairs);
   std::vector<Vec3> old_shear = std::move(pair_shear);
-  finder.build(p.position, p.radius, skin, teamSize(), pairs);
+  finder.build(p.position, p.radius, skin, teamSize(), pairs, model.max_grid_levels);
   const std::size_t np = pairs.size();
   pair_shear.assign(np, Vec3::Zero());
   pair_touch.assign(np, 0);
@@ -353,6 +355,7 @@ void World::Impl::rebuildNeighbours() {
   ++stats.neighbour_rebuilds;
   stats.pairs_in_list = np;
   stats.wall_candidates = wall_index.size();
+  stats.neighbour_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // ---------------------------------------------------------------------------

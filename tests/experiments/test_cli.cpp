@@ -1,5 +1,10 @@
 // The CLI in-process: exit codes, outputs, and "bad input loses nothing".
+#include <H5Cpp.h>
+
 #include <catch2/catch.hpp>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -72,4 +77,26 @@ TEST_CASE("bad input: exit code 2 and the previous outputs are untouched", "[cli
 TEST_CASE("check and list", "[cli]") {
   CHECK(cli({"check", kScene}) == 0);
   CHECK(cli({"list"}) == 0);
+}
+
+TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and results", "[cli]") {
+  const fs::path out = tempDir("sigint");
+  std::thread interrupter([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    std::raise(SIGINT);  // the handler runCli installed turns it into a clean stop
+  });
+  const int code = cli({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=100"});
+  interrupter.join();
+  CHECK(code == 130);
+  const auto r = nlohmann::json::parse(slurp(out / "results.json"));
+  CHECK(r["status"] == "interrupted");
+  CHECK(r["simulated_time_s"].get<double>() < 100);
+  H5::H5File file((out / "run.h5").string(), H5F_ACC_RDONLY);
+  CHECK(file.openGroup("frames").getNumObjs() >= 1);
+  int interrupted = 0;
+  file.openAttribute("interrupted").read(H5::PredType::NATIVE_INT, &interrupted);
+  CHECK(interrupted == 1);
+  CHECK(fs::exists(out / "checkpoint.h5"));
+  file.close();
+  fs::remove_all(out);
 }

@@ -11,10 +11,17 @@
 #include <type_traits>
 #include <utility>
 
-#include "rocklab/sim/particles.h"  // sim::Vec3
+#include "hdf5_io.h"
+#include "snapshot_check.h"
 
 namespace rocklab::sim::output {
 namespace {
+
+using detail::particleCount;
+using detail::writeArray;
+using detail::writeScalarAttribute;
+using detail::writeText;
+using detail::writeTextAttribute;
 
 constexpr int kFormatVersion = 1;
 constexpr hsize_t kEnergyColumns = 8;
@@ -27,67 +34,8 @@ constexpr const char* kEnergyColumnNames =
 // The table mixes quantities, so its "unit" lists one unit per column.
 constexpr const char* kEnergyUnits = "s, -, J, J, J, J, J, -";
 
-// A Vec3 array is handed to HDF5 as [n,3] contiguous doubles.
-static_assert(sizeof(Vec3) == 3 * sizeof(double));
-
-// How a C++ array element is stored: its HDF5 type and the number of columns of
-// the dataset (0 = a 1-D dataset).
-template <class T>
-struct Layout;
-template <>
-struct Layout<double> {
-  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
-  static constexpr hsize_t columns = 0;
-};
-template <>
-struct Layout<std::uint64_t> {
-  static const H5::PredType& type() { return H5::PredType::NATIVE_UINT64; }
-  static constexpr hsize_t columns = 0;
-};
-template <>
-struct Layout<Vec3> {
-  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
-  static constexpr hsize_t columns = 3;
-};
-
-H5::StrType textType() {
-  // Variable-length UTF-8: scene text of any length, with any characters.
-  H5::StrType type(H5::PredType::C_S1, H5T_VARIABLE);
-  type.setCset(H5T_CSET_UTF8);
-  return type;
-}
-
-void writeTextAttribute(const H5::H5Object& object, const char* name, const std::string& value) {
-  const H5::StrType type = textType();
-  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, value);
-}
-
-template <class T>
-void writeScalarAttribute(const H5::H5Object& object, const char* name, const H5::PredType& type,
-                          T value) {
-  object.createAttribute(name, type, H5::DataSpace(H5S_SCALAR)).write(type, &value);
-}
-
 void setIntAttribute(const H5::H5Object& object, const char* name, int value) {
   object.openAttribute(name).write(H5::PredType::NATIVE_INT, &value);
-}
-
-/// Writes `values` as a dataset of shape [n] or [n,3] with a "unit" attribute.
-template <class T>
-void writeArray(const H5::Group& group, const char* name, std::span<const T> values,
-                const char* unit) {
-  const std::array<hsize_t, 2> dims{values.size(), Layout<T>::columns};
-  const H5::DataSpace space(Layout<T>::columns == 0 ? 1 : 2, dims.data());
-  const H5::DataSet dataset = group.createDataSet(name, Layout<T>::type(), space);
-  if (!values.empty()) dataset.write(values.data(), Layout<T>::type());  // no buffer when n = 0
-  writeTextAttribute(dataset, "unit", unit);
-}
-
-void writeText(const H5::Group& group, const char* name, const std::string& text) {
-  const H5::StrType type = textType();
-  const H5::DataSet dataset = group.createDataSet(name, type, H5::DataSpace(H5S_SCALAR));
-  dataset.write(text, type);
-  writeTextAttribute(dataset, "unit", "");
 }
 
 H5::DataSet createEnergyTable(const H5::Group& group) {
@@ -102,24 +50,6 @@ H5::DataSet createEnergyTable(const H5::Group& group) {
   writeTextAttribute(table, "unit", kEnergyUnits);
   writeTextAttribute(table, "columns", kEnergyColumnNames);
   return table;
-}
-
-/// Number of particles in a snapshot; throws when its arrays differ in length.
-std::size_t particleCount(const Snapshot& s) {
-  const std::size_t n = s.position.size();
-  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", s.velocity.size()},
-                                                       {"omega", s.omega.size()},
-                                                       {"force", s.force.size()},
-                                                       {"radius", s.radius.size()},
-                                                       {"id", s.id.size()}};
-  for (const auto& [name, size] : sizes) {
-    if (size != n) {
-      throw std::invalid_argument("snapshot: " + std::string(name) + " has " +
-                                  std::to_string(size) + " entries but position has " +
-                                  std::to_string(n));
-    }
-  }
-  return n;
 }
 
 std::string frameGroupName(std::size_t frame) {

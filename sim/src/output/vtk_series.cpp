@@ -22,27 +22,12 @@
 #include <utility>
 
 #include "rocklab/sim/particles.h"  // sim::Vec3
+#include "snapshot_check.h"
 
 namespace rocklab::sim::output {
 namespace {
 
-/// Number of particles in a snapshot; throws when its arrays differ in length.
-std::size_t particleCount(const Snapshot& s) {
-  const std::size_t n = s.position.size();
-  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", s.velocity.size()},
-                                                       {"omega", s.omega.size()},
-                                                       {"force", s.force.size()},
-                                                       {"radius", s.radius.size()},
-                                                       {"id", s.id.size()}};
-  for (const auto& [name, size] : sizes) {
-    if (size != n) {
-      throw std::invalid_argument("snapshot: " + std::string(name) + " has " +
-                                  std::to_string(size) + " entries but position has " +
-                                  std::to_string(n));
-    }
-  }
-  return n;
-}
+using detail::particleCount;
 
 vtkSmartPointer<vtkDoubleArray> vectorArray(const char* name, std::span<const Vec3> values) {
   auto array = vtkSmartPointer<vtkDoubleArray>::New();

@@ -98,6 +98,7 @@ struct Model {
   TimestepSettings timestep;
   WatchdogSettings watchdog;
   double skin = 0.0;  // m  Verlet skin; 0 = 0.2 x mean radius
+  int max_grid_levels = 8;  // neighbour grid levels (one per doubling of the radius); 1 = plain grid
 };
 
 /// A sphere to add to a world.

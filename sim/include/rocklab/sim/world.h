@@ -62,6 +62,7 @@ struct WorldStats {
   std::uint64_t neighbour_rebuilds = 0;
   std::size_t pairs_in_list = 0;
   std::size_t wall_candidates = 0;
+  double neighbour_seconds = 0.0;  // s of wall time spent in neighbour-list rebuilds
 };
 
 class World {
