@@ -68,17 +68,23 @@ struct World::Impl {
   detail::PairList pairs;
   std::vector<Vec3> pair_shear;      // [pairs] N, shear spring force on i (history)
   std::vector<std::uint8_t> pair_touch;  // [pairs] 1 when touching at this step
-  std::vector<Vec3> pair_force_j;    // [pairs] N, force on j
-  std::vector<Vec3> pair_torque_j;   // [pairs] N m, torque on j
+  // Ranges of balls per thread, and the slots of pairs that cross two ranges.
+  struct CrossSlot {
+    Vec3 fi, ti, fj, tj;  // N, N m on the first and the second ball
+  };
+  static constexpr std::uint32_t kNotCross = 0xffffffffu;
+  std::vector<std::uint32_t> range_begin;  // [team+1]
+  std::vector<std::uint32_t> cross_index;  // [pairs] slot, or kNotCross
+  std::vector<CrossSlot> cross;
   // Ball–wall candidates in rows by ball.
   std::vector<std::uint32_t> wall_offset;  // [n+1]
   std::vector<std::uint32_t> wall_index;   // [k]
   std::vector<Vec3> wall_shear;            // [k] N on the ball
   std::vector<std::uint8_t> wall_touch;    // [k]
-  // Per-ball accumulators of stage 3 (own-row pairs and walls).
+  // Per-ball force and torque accumulators (contacts only).
   std::vector<Vec3> acc_force, acc_torque;
   // Observation buffers (filled only on observed steps).
-  std::vector<Vec3> obs_force, obs_torque, obs_velocity, obs_omega;
+  std::vector<Vec3> obs_velocity, obs_omega;
   // Skin bookkeeping.
   std::vector<Vec3> ref_position;
   bool need_rebuild = true;
@@ -88,11 +94,11 @@ struct World::Impl {
   double energy_ref = 0.0, energy_scale = 0.0;
   StepChecks checks;
 
-  // Below this many balls a step is a few tens of microseconds and the fork/join
-  // of a second thread costs more than it saves (measured: 1500 balls ran at half
-  // speed on 2 threads), so small worlds step on one thread. Results are bitwise
-  // the same either way.
-  static constexpr std::size_t kMinBallsPerThread = 2500;
+  // Below this many balls per thread the fork/join of a step costs more than
+  // the second thread saves (measured with the one-region step: 2000 balls run
+  // 1.7x faster on 2 threads, 1500 balls 1.3x). Results are bitwise the same
+  // whatever the team size.
+  static constexpr std::size_t kMinBallsPerThread = 500;
   int teamSize() const {
     const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
     return std::max(1, std::min(threads, useful));
@@ -101,8 +107,11 @@ struct World::Impl {
   void buildPairProps();
   void prepareStage();
   void rebuildNeighbours();
-  template <class Law> void contactStage();
-  void gather(std::size_t i, Vec3& f, Vec3& t) const;
+  template <class Law>
+  bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
+  template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
+  template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
+  void assignRanges();
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
   template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
   Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
@@ -312,8 +321,6 @@ void World::Impl::rebuildNeighbours() {
   const std::size_t np = pairs.size();
   pair_shear.assign(np, Vec3::Zero());
   pair_touch.assign(np, 0);
-  pair_force_j.resize(np);
-  pair_torque_j.resize(np);
   // Carry shear history over by merging old and new rows (both sorted by j).
   if (!old.row_offset.empty()) {
 #pragma omp parallel for schedule(static) num_threads(teamSize())
@@ -352,115 +359,171 @@ void World::Impl::rebuildNeighbours() {
   for (auto& wr : walls) wr.setReference();
   last_max_disp2 = 0.0;
   need_rebuild = false;
+  assignRanges();
   ++stats.neighbour_rebuilds;
   stats.pairs_in_list = np;
   stats.wall_candidates = wall_index.size();
   stats.neighbour_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// ---------------------------------------------------------------------------
-// Stage 3: contacts
-
-template <class Law>
-void World::Impl::contactStage() {
+void World::Impl::assignRanges() {
   const std::size_t n = p.size();
-  const ContactModel& cm = model.contact;
-  const bool average_mass = cm.damping_mass == DampingMass::Average;
-  const double overlap_limit = model.watchdog.max_overlap_fraction;
-  const double h = dt;
-  StepChecks merged;
-#pragma omp parallel num_threads(teamSize())
-  {
-    StepChecks local;
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 xi = p.position[i], vi = p.velocity[i], wi = p.omega[i];
-      const double ri = p.radius[i], mi = p.mass[i];
-      const std::size_t mat_i = static_cast<std::size_t>(p.material[i]);
-      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
-      // Ball–ball pairs in which i is the first ball.
-      for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
-        const std::uint32_t j = pairs.partner[k];
-        const Vec3 d = p.position[j] - xi;
-        const double rj = p.radius[j];
-        const double rsum = ri + rj;
-        const double dist2 = d.squaredNorm();
-        if (dist2 >= rsum * rsum) {
-          pair_touch[k] = 0;
-          pair_shear[k].setZero();
-          continue;
-        }
-        const double dist = std::sqrt(dist2);
-        detail::ContactGeometry g;
-        g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
-        g.overlap = rsum - dist;
-        const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point
-        const Vec3 ai = cp - xi, aj = cp - p.position[j];
-        g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (vi + wi.cross(ai));
-        g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
-        const double mj = p.mass[j];
-        g.damping_mass = average_mass ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
-        const PairProps& props = ball_ball[mat_i * nm + static_cast<std::size_t>(p.material[j])];
-        const detail::ContactResult res = detail::evaluateContact<Law>(props, cm, g, h, pair_shear[k]);
-        f += res.force;
-        t += ai.cross(res.force);
-        pair_force_j[k] = -res.force;
-        pair_torque_j[k] = aj.cross(-res.force);
-        pair_touch[k] = 1;
-        const double r_small = std::min(ri, rj);
-        if (g.overlap > overlap_limit * r_small)
-          mergeWorst(local, g.overlap / r_small, (std::uint64_t(i) << 32) | j);
-      }
-      // Ball–wall contacts.
-      for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c) {
-        const std::uint32_t wk = wall_index[c];
-        const detail::WallRuntime& wr = walls[wk];
-        detail::WallContact wc;
-        if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
-          wall_touch[c] = 0;
-          wall_shear[c].setZero();
-          continue;
-        }
-        detail::ContactGeometry g;
-        g.normal = wc.normal;
-        g.overlap = wc.overlap;
-        const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
-        const Vec3 ai = cp - xi;
-        g.rel_velocity = wr.velocityAt(cp) - (vi + wi.cross(ai));
-        g.r_tilde = ri;   // mirror-image ball (ref §4.2)
-        g.damping_mass = mi;  // ball–wall dashpot uses the ball's mass (Eq 2-18)
-        const PairProps& props =
-            ball_wall[mat_i * nm + static_cast<std::size_t>(model.walls[wk].material)];
-        const detail::ContactResult res = detail::evaluateContact<Law>(props, cm, g, h, wall_shear[c]);
-        f += res.force;
-        t += ai.cross(res.force);
-        wall_touch[c] = 1;
-        if (g.overlap > overlap_limit * ri)
-          mergeWorst(local, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
-      }
-      acc_force[i] = f;
-      acc_torque[i] = t;
-    }
-#pragma omp critical
-    mergeWorst(merged, local.worst_overlap, local.worst_key);
-  }
-  checks.worst_overlap = merged.worst_overlap;
-  checks.worst_key = merged.worst_key;
+  const int team = teamSize();
+  range_begin.resize(static_cast<std::size_t>(team) + 1);
+  for (int t = 0; t <= team; ++t) range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
+  cross_index.assign(pairs.size(), kNotCross);
+  std::uint32_t slots = 0;
+  for (int t = 0; t < team; ++t)
+    for (std::uint32_t i = range_begin[t]; i < range_begin[t + 1]; ++i)
+      for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k)
+        if (pairs.partner[k] >= range_begin[t + 1]) cross_index[k] = slots++;
+  cross.resize(slots);
 }
 
 // ---------------------------------------------------------------------------
-// Stages 4 and 6: gather and integrate
+// Stages 3, 4 and 6: contacts, gather and integrate in one pass
+//
+// Each thread owns a contiguous range of balls [b, e). A pair (i, j), i < j, is
+// evaluated once. Its force on j is added straight into j's accumulator when j is
+// in the same range; when j lies in a later range the pair is a "cross" pair,
+// evaluated first (phase A, before a barrier) into a slot that both threads read.
+// Every ball then receives its contributions in one fixed order — from the pairs
+// (i', p) in ascending i', then its own row in ascending j, then its walls — on
+// any number of threads, so results are bitwise independent of the thread count.
+// A ball is complete once its own row is done (later balls never read it in this
+// step), so it is integrated right there unless an observer needs the forces.
 
-inline void World::Impl::gather(std::size_t i, Vec3& f, Vec3& t) const {
-  // Own-row contributions first, then pairs where i is second, in ascending i:
-  // a fixed order, so the sum does not depend on threads or rebuild times.
-  f = acc_force[i];
-  t = acc_torque[i];
-  for (std::uint32_t c = pairs.col_offset[i]; c < pairs.col_offset[i + 1]; ++c) {
-    const std::uint32_t k = pairs.col_pair[c];
-    if (!pair_touch[k]) continue;
-    f += pair_force_j[k];
-    t += pair_torque_j[k];
+template <class Law>
+[[gnu::always_inline]] inline bool World::Impl::evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj,
+                                      Vec3& tj, StepChecks& c) {
+  const std::uint32_t j = pairs.partner[k];
+  const Vec3 xi = p.position[i];
+  const Vec3 d = p.position[j] - xi;
+  const double ri = p.radius[i], rj = p.radius[j];
+  const double rsum = ri + rj;
+  const double dist2 = d.squaredNorm();
+  if (dist2 >= rsum * rsum) {
+    pair_touch[k] = 0;
+    pair_shear[k].setZero();
+    return false;
+  }
+  const double dist = std::sqrt(dist2);
+  detail::ContactGeometry g;
+  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
+  g.overlap = rsum - dist;
+  const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point: middle of the overlap
+  const Vec3 ai = cp - xi, aj = cp - p.position[j];
+  g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
+  g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
+  const double mi = p.mass[i], mj = p.mass[j];
+  g.damping_mass = model.contact.damping_mass == DampingMass::Average ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
+  const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
+  const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, pair_shear[k]);
+  fi = res.force;
+  ti = ai.cross(res.force);
+  fj = -res.force;
+  tj = aj.cross(fj);
+  pair_touch[k] = 1;
+  const double r_small = std::min(ri, rj);
+  if (g.overlap > model.watchdog.max_overlap_fraction * r_small)
+    mergeWorst(c, g.overlap / r_small, (std::uint64_t(i) << 32) | j);
+  return true;
+}
+
+template <class Law>
+inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c) {
+  const Vec3 xi = p.position[i];
+  const double ri = p.radius[i];
+  for (std::uint32_t w = wall_offset[i]; w < wall_offset[i + 1]; ++w) {
+    const std::uint32_t wk = wall_index[w];
+    const detail::WallRuntime& wr = walls[wk];
+    detail::WallContact wc;
+    if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
+      wall_touch[w] = 0;
+      wall_shear[w].setZero();
+      continue;
+    }
+    detail::ContactGeometry g;
+    g.normal = wc.normal;
+    g.overlap = wc.overlap;
+    const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
+    const Vec3 ai = cp - xi;
+    g.rel_velocity = wr.velocityAt(cp) - (p.velocity[i] + p.omega[i].cross(ai));
+    g.r_tilde = ri;            // mirror-image ball (ref §4.2)
+    g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)
+    const PairProps& props =
+        ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wk].material)];
+    const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, wall_shear[w]);
+    f += res.force;
+    t += ai.cross(res.force);
+    wall_touch[w] = 1;
+    if (g.overlap > model.watchdog.max_overlap_fraction * ri)
+      mergeWorst(c, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
+  }
+}
+
+template <class Law>
+void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
+  const int team = static_cast<int>(range_begin.size()) - 1;
+#pragma omp parallel num_threads(team)
+  {
+    const int th = omp_get_thread_num();
+    const std::uint32_t b = range_begin[th], e = range_begin[th + 1];
+    StepChecks local;
+    // Phase A: pairs whose second ball belongs to a later range.
+    for (std::uint32_t i = b; i < e; ++i)
+      for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
+        if (pairs.partner[k] < e) continue;
+        CrossSlot& s = cross[cross_index[k]];
+        evaluatePair<Law>(i, k, s.fi, s.ti, s.fj, s.tj, local);
+      }
+#pragma omp barrier
+    // Phase B: start every ball of the range with the cross contributions it
+    // receives (pairs (i', p), i' < b, ascending i').
+    for (std::uint32_t q = b; q < e; ++q) {
+      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
+      for (std::uint32_t c = pairs.col_offset[q]; b > 0 && c < pairs.col_offset[q + 1]; ++c) {
+        const std::uint32_t k = pairs.col_pair[c];
+        if (cross_index[k] == kNotCross) break;  // the rest come from this range
+        if (!pair_touch[k]) continue;
+        f += cross[cross_index[k]].fj;
+        t += cross[cross_index[k]].tj;
+      }
+      acc_force[q] = f;
+      acc_torque[q] = t;
+    }
+    // ...then every ball's own row (scattering to partners in the range) and walls.
+    for (std::uint32_t i = b; i < e; ++i) {
+      Vec3 f = acc_force[i], t = acc_torque[i];
+      for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
+        if (cross_index[k] != kNotCross) {
+          if (!pair_touch[k]) continue;
+          f += cross[cross_index[k]].fi;
+          t += cross[cross_index[k]].ti;
+          continue;
+        }
+        Vec3 fi, ti, fj, tj;
+        if (!evaluatePair<Law>(i, k, fi, ti, fj, tj, local)) continue;
+        f += fi;
+        t += ti;
+        const std::uint32_t j = pairs.partner[k];
+        acc_force[j] += fj;
+        acc_torque[j] += tj;
+      }
+      addWallForces<Law>(i, f, t, local);
+      if (integrate_now) {
+        integrate(i, f, t, h, local);
+      } else {
+        acc_force[i] = f;
+        acc_torque[i] = t;
+      }
+    }
+#pragma omp critical
+    {
+      mergeWorst(merged, local.worst_overlap, local.worst_key);
+      merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
+      merged.non_finite = merged.non_finite || local.non_finite;
+    }
   }
 }
 
@@ -612,46 +675,29 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   const std::size_t n = p.size();
   prepareStage();                                     // 1
   if (need_rebuild) rebuildNeighbours();              // 2
-  if (model.contact.law == ContactLaw::Linear)        // 3
-    contactStage<detail::LinearLaw>();
-  else
-    contactStage<detail::HertzMindlinLaw>();
-  checkOverlap();
-
   const double h = half_kick_pending ? 0.5 * dt : dt;
   const int interval = std::max(1, model.watchdog.check_interval);
   const bool energy_due = (step % static_cast<std::uint64_t>(interval)) == 0 && energyCheckApplies();
+  const bool observe = observer || energy_due;
   StepChecks merged;
-  if (!observer && !energy_due) {
-    // 4 + 6 fused: gather and integrate in one pass.
-#pragma omp parallel num_threads(teamSize())
-    {
-      StepChecks local;
-#pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) {
-        Vec3 f, t;
-        gather(i, f, t);
-        integrate(i, f, t, h, local);
-      }
-#pragma omp critical
-      {
-        merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
-        merged.non_finite = merged.non_finite || local.non_finite;
-      }
-    }
-  } else {
-    // 4, 5, 6 apart: the snapshot needs the whole-step state before the kick.
-    obs_force.resize(n);
-    obs_torque.resize(n);
+  // 3 + 4 (+ 6 unless observed): contacts, gather, integrate.
+  if (model.contact.law == ContactLaw::Linear)
+    forcePass<detail::LinearLaw>(!observe, h, merged);
+  else
+    forcePass<detail::HertzMindlinLaw>(!observe, h, merged);
+  checks.worst_overlap = merged.worst_overlap;
+  checks.worst_key = merged.worst_key;
+  checkOverlap();
+
+  if (observe) {
+    // 5: the snapshot needs the whole-step state before the kick.
     obs_velocity.resize(n);
     obs_omega.resize(n);
-#pragma omp parallel for schedule(static) num_threads(teamSize())
+    // v(t) = v(t - dt/2) + a(t) dt/2; at the first step v holds v(0) already.
+    const double half = half_kick_pending ? 0.0 : 0.5 * dt;
     for (std::size_t i = 0; i < n; ++i) {
-      gather(i, obs_force[i], obs_torque[i]);
-      // v(t) = v(t - dt/2) + a(t) dt/2; at the first step v holds v(0) already.
-      const double half = half_kick_pending ? 0.0 : 0.5 * dt;
-      obs_velocity[i] = p.velocity[i] + half * (obs_force[i] * p.inv_mass[i] + gravity);
-      obs_omega[i] = p.omega[i] + half * p.inv_inertia[i] * obs_torque[i];
+      obs_velocity[i] = p.velocity[i] + half * (acc_force[i] * p.inv_mass[i] + gravity);
+      obs_omega[i] = p.omega[i] + half * p.inv_inertia[i] * acc_torque[i];
     }
     Snapshot s;
     s.time = time;
@@ -659,9 +705,8 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     s.energy = energyAny(obs_velocity, obs_omega);
     if (energy_due) checkEnergy(s.energy);
     if (observer) {
-      // Report total force including gravity.
-      std::vector<Vec3> total(n);
-      for (std::size_t i = 0; i < n; ++i) total[i] = obs_force[i] + gravity * p.mass[i];
+      std::vector<Vec3> total(n);  // total force including gravity
+      for (std::size_t i = 0; i < n; ++i) total[i] = acc_force[i] + gravity * p.mass[i];
       s.position = p.position;
       s.velocity = obs_velocity;
       s.omega = obs_omega;
@@ -673,11 +718,12 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
       s.max_overlap_fraction = checks.worst_overlap;
       observer(s);
     }
+    // 6
 #pragma omp parallel num_threads(teamSize())
     {
       StepChecks local;
 #pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) integrate(i, obs_force[i], obs_torque[i], h, local);
+      for (std::size_t i = 0; i < n; ++i) integrate(i, acc_force[i], acc_torque[i], h, local);
 #pragma omp critical
       {
         merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
