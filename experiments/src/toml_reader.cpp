@@ -24,6 +24,21 @@ std::string typeName(const toml::node& n) {
     default: return "a date/time";
   }
 }
+/// A finite number, integer or float; false otherwise.
+bool toNumber(const toml::node& n, double& out) {
+  if (auto f = n.as_floating_point()) out = f->get();
+  else if (auto i = n.as_integer()) out = static_cast<double>(i->get());
+  else return false;
+  return std::isfinite(out);
+}
+/// An array of exactly 3 finite numbers; false otherwise.
+bool toVec3(const toml::node& n, geometry::Vec3& out) {
+  auto a = n.as_array();
+  if (!a || a->size() != 3) return false;
+  for (int k = 0; k < 3; ++k)
+    if (!toNumber(*a->get(static_cast<std::size_t>(k)), out[k])) return false;
+  return true;
+}
 }  // namespace
 
 std::string Range::describe() const {
@@ -139,16 +154,8 @@ std::string TableReader::requiredString(const std::string& key, const std::vecto
 geometry::Vec3 TableReader::vec3(const std::string& key, const geometry::Vec3& fallback) {
   const toml::node* n = node(key);
   if (!n) return fallback;
-  auto a = n->as_array();
-  if (!a || a->size() != 3) fail(key, "expected an array of 3 numbers [x, y, z]");
   geometry::Vec3 v;
-  for (int k = 0; k < 3; ++k) {
-    const toml::node& e = *a->get(static_cast<std::size_t>(k));
-    if (auto f = e.as_floating_point()) v[k] = f->get();
-    else if (auto i = e.as_integer()) v[k] = static_cast<double>(i->get());
-    else fail(key, "expected an array of 3 numbers [x, y, z]");
-    if (!std::isfinite(v[k])) fail(key, "components must be finite");
-  }
+  if (!toVec3(*n, v)) fail(key, "expected an array of 3 finite numbers [x, y, z]");
   return v;
 }
 
@@ -164,15 +171,8 @@ std::vector<geometry::Vec3> TableReader::vec3List(const std::string& key) {
   auto a = n->as_array();
   if (!a) fail(key, "expected an array of [x, y, z] arrays");
   for (const toml::node& e : *a) {
-    auto p = e.as_array();
-    if (!p || p->size() != 3) fail(key, "expected an array of [x, y, z] arrays");
     geometry::Vec3 v;
-    for (int k = 0; k < 3; ++k) {
-      const toml::node& c = *p->get(static_cast<std::size_t>(k));
-      if (auto f = c.as_floating_point()) v[k] = f->get();
-      else if (auto i = c.as_integer()) v[k] = static_cast<double>(i->get());
-      else fail(key, "expected an array of [x, y, z] arrays of numbers");
-    }
+    if (!toVec3(e, v)) fail(key, "expected an array of [x, y, z] arrays of finite numbers");
     out.push_back(v);
   }
   return out;
@@ -186,9 +186,7 @@ std::vector<double> TableReader::numberList(const std::string& key, Range range)
   if (!a) fail(key, "expected an array of numbers " + range.describe());
   for (const toml::node& e : *a) {
     double v;
-    if (auto f = e.as_floating_point()) v = f->get();
-    else if (auto i = e.as_integer()) v = static_cast<double>(i->get());
-    else fail(key, "expected an array of numbers " + range.describe());
+    if (!toNumber(e, v)) fail(key, "expected an array of finite numbers " + range.describe());
     if (!range.contains(v)) fail(key, "an element is out of range; allowed: " + range.describe());
     out.push_back(v);
   }

@@ -2,6 +2,7 @@
 // key, value and what is allowed; built-in scenes load.
 #include <catch2/catch.hpp>
 #include <filesystem>
+#include <fstream>
 
 #include "rocklab/experiments/scene.h"
 
@@ -96,4 +97,39 @@ TEST_CASE("every built-in scene loads", "[scene]") {
     ++count;
   }
   CHECK(count >= 1);
+}
+
+TEST_CASE("mesh walls from an STL file (assimp) and inline triangles", "[scene]") {
+  const auto dir = std::filesystem::temp_directory_path() / "rocklab-scene-mesh";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream stl(dir / "floor.stl");
+    stl << "solid floor\n"
+           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 0 0\n   vertex 1000 1000 0\n"
+           "  endloop\n endfacet\n"
+           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 1000 0\n   vertex 0 1000 0\n"
+           "  endloop\n endfacet\nendsolid floor\n";
+  }
+  const std::string walls = R"(
+[[walls]]
+type = "mesh"
+material = "rock"
+file = "floor.stl"
+scale = 0.001          # the file is in mm
+
+[[walls]]
+type = "mesh"
+material = "rock"
+vertices = [[0, 0, 1], [1, 0, 1], [0, 1, 1]]
+triangles = [[0, 1, 2]]
+)";
+  const Scene s = loadSceneText(kMinimal + walls, "mesh.toml", {}, dir);
+  REQUIRE(s.model.walls.size() == 2);
+  CHECK(s.model.walls[0].mesh.triangleCount() == 2);
+  CHECK(s.model.walls[0].mesh.vertices.size() == 4);  // welded
+  CHECK(s.model.walls[0].mesh.bounds().hi.x() == Approx(1.0));
+  CHECK(s.model.walls[1].mesh.triangleCount() == 1);
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"missing.stl\"\n"),
+             Contains("key 'walls.0.file' = \"missing.stl\": cannot read mesh"));
+  std::filesystem::remove_all(dir);
 }
