@@ -225,7 +225,12 @@ void TableReader::finish() const {
     std::string allowed;
     for (const auto& u : used_) allowed += (allowed.empty() ? "" : ", ") + u;
     std::ostringstream s;
-    s << where(v.source()) << "unknown key '" << keyPath(key) << "'";
+    const auto over = overrides_ ? overrides_->find(keyPath(key)) : Overrides::const_iterator{};
+    if (overrides_ && over != overrides_->end())
+      s << "--set " << over->second << ": ";
+    else
+      s << where(v.source());
+    s << "unknown key '" << keyPath(key) << "'";
     if (!allowed.empty()) s << "; known keys here: " << allowed;
     throw SceneError(s.str());
   }

@@ -94,11 +94,12 @@ struct World::Impl {
   double energy_ref = 0.0, energy_scale = 0.0;
   StepChecks checks;
 
-  // Below this many balls per thread the fork/join of a step costs more than
-  // the second thread saves (measured with the one-region step: 2000 balls run
-  // 1.7x faster on 2 threads, 1500 balls 1.3x). Results are bitwise the same
-  // whatever the team size.
-  static constexpr std::size_t kMinBallsPerThread = 500;
+  // Below this many balls per thread a second thread does not pay: a step of a
+  // few thousand balls takes tens of microseconds, and waking the team, the
+  // barrier and the cross-range pairs cost as much (measured: the 1500-ball demo
+  // ran 1.65x slower on 2 threads, while 2000 lattice balls ran 1.7x faster, and
+  // 16000 balls 1.5-1.9x faster). Results are bitwise the same whatever the team.
+  static constexpr std::size_t kMinBallsPerThread = 2500;
   int teamSize() const {
     const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
     return std::max(1, std::min(threads, useful));

@@ -86,6 +86,7 @@ TEST_CASE("option set overrides: values - array indices and bad paths", "[scene]
   CHECK_THAT(s.text, Contains("end_time = 2"));  // the effective scene is what gets stored
   CHECK_THAT(errorOf(kMinimal, {"particles.3.radius=1"}), Contains("index 3 is beyond the 1 entries"));
   CHECK_THAT(errorOf(kMinimal, {"noequals"}), Contains("expected key=value"));
+  CHECK_THAT(errorOf(kMinimal, {"scene.end_tim=3"}), Contains("--set scene.end_tim=3: unknown key 'scene.end_tim'"));
 }
 
 TEST_CASE("every built-in scene loads", "[scene]") {
