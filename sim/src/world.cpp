@@ -716,7 +716,6 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
       s.id = p.id;
       for (std::uint8_t t : pair_touch) s.contacts += t;
       for (std::uint8_t t : wall_touch) s.wall_contacts += t;
-      s.max_overlap_fraction = checks.worst_overlap;
       observer(s);
     }
     // 6

@@ -1,7 +1,5 @@
 #pragma once
 // Small builders shared by the sim tests.
-#include <functional>
-
 #include "rocklab/sim/world.h"
 
 namespace rocklab::test {
@@ -35,11 +33,6 @@ inline sim::SphereSpec sphere(Vec3 x, double r, Vec3 v = Vec3::Zero()) {
   s.radius = r;
   s.velocity = v;
   return s;
-}
-
-/// Steps until `done` says so (or max_steps), calling `each` after every step.
-inline void stepUntil(sim::World& w, std::uint64_t max_steps, const std::function<bool()>& done) {
-  for (std::uint64_t k = 0; k < max_steps && !done(); ++k) w.step();
 }
 
 }  // namespace rocklab::test

@@ -31,7 +31,6 @@ struct Snapshot {
   Energy energy;
   std::size_t contacts = 0;       // touching ball–ball pairs
   std::size_t wall_contacts = 0;  // touching ball–wall pairs
-  double max_overlap_fraction = 0.0;  // max overlap / smaller radius over contacts
 };
 
 }  // namespace rocklab::sim
