@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -145,26 +146,20 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   modules.push_back(model.contact.law == sim::ContactLaw::Linear ? "contact:linear" : "contact:hertz_mindlin");
   if (model.contact.damping_normal > 0 || model.contact.damping_shear > 0) modules.push_back("damping:viscous");
   if (model.contact.local_damping > 0) modules.push_back("damping:local");
-  for (const char* shape : {"plane", "polygon", "mesh"}) {
-    for (const auto& w : model.walls) {
-      const char* s = w.shape == sim::WallShape::Plane ? "plane" : w.shape == sim::WallShape::Polygon ? "polygon" : "mesh";
-      if (std::string(s) == shape) {
-        modules.push_back(std::string("walls:") + shape);
-        break;
-      }
-    }
-  }
-  bool moving = false;
-  for (const auto& w : model.walls) moving = moving || !w.motion.isStatic();
-  if (moving) modules.push_back("walls:moving");
+  const std::pair<sim::WallShape, const char*> shapes[] = {
+      {sim::WallShape::Plane, "walls:plane"}, {sim::WallShape::Polygon, "walls:polygon"}, {sim::WallShape::Mesh, "walls:mesh"}};
+  auto anyWall = [&model](auto predicate) { return std::any_of(model.walls.begin(), model.walls.end(), predicate); };
+  for (const auto& [shape, name] : shapes)
+    if (anyWall([shape = shape](const sim::Wall& w) { return w.shape == shape; })) modules.push_back(name);
+  if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); })) modules.push_back("walls:moving");
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
   if (scene.run.hdf5) modules.push_back("output:hdf5");
   if (scene.run.vtk) modules.push_back("output:vtk");
   if (scene.run.checkpoint) modules.push_back("output:checkpoint");
 
   log << "rocklab: scene '" << scene.run.name << "'" << (options.restart.empty() ? "" : " (restart)") << ", "
-      << world->particles().size() << " spheres, " << model.walls.size() << " walls, " << world->threads()
-      << " threads\n";
+      << world->particles().size() << " spheres, " << model.walls.size() << " walls, threads: "
+      << world->threads() << "\n";
   log << "  modules: ";
   for (std::size_t k = 0; k < modules.size(); ++k) log << (k ? ", " : "") << modules[k];
   log << "\n" << world->timestepAudit().describe(model.timestep) << "\n";

@@ -56,7 +56,7 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
                const std::filesystem::path& base_dir, sim::Model& model) {
   for (TableReader t : root.tableArray("walls")) {
     const std::string type = t.requiredString("type", {"plane", "polygon", "mesh", "box"});
-    const std::string name = t.string("name", t.keyPath("").substr(0, t.keyPath("").size() - 1));
+    const std::string name = t.string("name", t.path());
     sim::Wall w;
     w.name = name;
     w.material = materialIndex(t, materials);

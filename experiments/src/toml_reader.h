@@ -60,6 +60,8 @@ class TableReader {
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   std::string keyPath(const std::string& key) const;
+  /// Dotted key of this table, e.g. "walls.2".
+  const std::string& path() const { return path_; }
   const toml::table& raw() const { return *table_; }
 
  private:

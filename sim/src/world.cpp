@@ -5,13 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <sstream>
 
 #include "contact_kernel.h"
 #include "neighbor_list.h"
-#include "rocklab/geometry/closest_point.h"
 #include "wall_runtime.h"
 
 namespace rocklab::sim {
@@ -34,6 +32,13 @@ void mergeWorst(StepChecks& into, double ratio, std::uint64_t key) {
     into.worst_overlap = ratio;
     into.worst_key = key;
   }
+}
+
+/// Folds one thread's checks into the step's (call inside `omp critical`).
+void mergeChecks(StepChecks& into, const StepChecks& from) {
+  mergeWorst(into, from.worst_overlap, from.worst_key);
+  into.max_disp2 = std::max(into.max_disp2, from.max_disp2);
+  into.non_finite = into.non_finite || from.non_finite;
 }
 
 std::string fmtNum(double x) {
@@ -92,7 +97,6 @@ struct World::Impl {
   // Watchdog energy reference.
   bool energy_ref_valid = false;
   double energy_ref = 0.0, energy_scale = 0.0;
-  StepChecks checks;
 
   // Below this many balls per thread a second thread does not pay: a step of a
   // few thousand balls takes tens of microseconds, and waking the team, the
@@ -116,7 +120,7 @@ struct World::Impl {
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
   template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
   Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
-  void checkOverlap() const;
+  void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
   void checkEnergy(const Energy& e);
   bool energyCheckApplies() const;
@@ -520,11 +524,7 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
       }
     }
 #pragma omp critical
-    {
-      mergeWorst(merged, local.worst_overlap, local.worst_key);
-      merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
-      merged.non_finite = merged.non_finite || local.non_finite;
-    }
+    mergeChecks(merged, local);
   }
 }
 
@@ -601,7 +601,7 @@ std::string World::Impl::stepAdvice() const {
   return s.str();
 }
 
-void World::Impl::checkOverlap() const {
+void World::Impl::checkOverlap(const StepChecks& checks) const {
   if (checks.worst_overlap <= model.watchdog.max_overlap_fraction) return;
   const auto i = static_cast<std::size_t>(checks.worst_key >> 32);
   const auto low = static_cast<std::uint32_t>(checks.worst_key & 0xffffffffu);
@@ -686,9 +686,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     forcePass<detail::LinearLaw>(!observe, h, merged);
   else
     forcePass<detail::HertzMindlinLaw>(!observe, h, merged);
-  checks.worst_overlap = merged.worst_overlap;
-  checks.worst_key = merged.worst_key;
-  checkOverlap();
+  checkOverlap(merged);
 
   if (observe) {
     // 5: the snapshot needs the whole-step state before the kick.
@@ -725,10 +723,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
 #pragma omp for schedule(static)
       for (std::size_t i = 0; i < n; ++i) integrate(i, acc_force[i], acc_torque[i], h, local);
 #pragma omp critical
-      {
-        merged.max_disp2 = std::max(merged.max_disp2, local.max_disp2);
-        merged.non_finite = merged.non_finite || local.non_finite;
-      }
+      mergeChecks(merged, local);
     }
   }
   half_kick_pending = false;
@@ -747,7 +742,7 @@ const Model& World::model() const { return impl_->model; }
 const ParticleState& World::particles() const { return impl_->p; }
 const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
 const WorldStats& World::stats() const { return impl_->stats; }
-int World::threads() const { return impl_->threads; }
+int World::threads() const { return impl_->teamSize(); }
 Vec3 World::gravity() const { return impl_->gravity; }
 
 WorldState World::exportState() const {

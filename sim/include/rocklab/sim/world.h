@@ -87,6 +87,7 @@ class World {
   const ParticleState& particles() const;
   const TimestepAudit& timestepAudit() const;
   const WorldStats& stats() const;
+  /// Threads the step really uses: the requested ones, fewer for small worlds.
   int threads() const;
   Vec3 gravity() const;
 
