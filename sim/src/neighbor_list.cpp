@@ -15,7 +15,8 @@ constexpr double kMaxCellsPerBall = 8.0;
 }  // namespace
 
 void NeighborFinder::build(std::span<const Vec3> position, std::span<const double> radius,
-                           double skin, int threads, PairList& out, int max_levels) {
+                           double skin, int threads, PairList& out, int max_levels,
+                           std::span<const std::int32_t> group) {
   const std::size_t n = position.size();
   out.row_offset.assign(n + 1, 0);
   out.col_offset.assign(n + 1, 0);
@@ -122,6 +123,7 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
                 if (same && j <= i) continue;
                 const double cut = ri + radius[j] + skin;
                 if ((position[j] - xi).squaredNorm() >= cut * cut) continue;
+                if (!group.empty() && group[i] >= 0 && group[i] == group[j]) continue;
                 const std::uint64_t a = std::min<std::uint64_t>(i, j), b = std::max<std::uint64_t>(i, j);
                 keys.push_back((a << 32) | b);
               }

@@ -29,8 +29,11 @@ struct PairList {
 class NeighborFinder {
  public:
   /// Rebuilds `out` for the given balls. `threads` as for OpenMP num_threads.
+  /// Balls with the same `group` >= 0 (members of one clump) never pair; an empty
+  /// `group` means every ball is on its own.
   void build(std::span<const Vec3> position, std::span<const double> radius, double skin,
-             int threads, PairList& out, int max_levels = 8);
+             int threads, PairList& out, int max_levels = 8,
+             std::span<const std::int32_t> group = {});
 
  private:
   struct Level {

@@ -55,7 +55,7 @@ std::string TimestepAudit::describe(const TimestepSettings& settings) const {
   s.precision(4);
   s << "time step audit:\n";
   s << "  spring, translational sqrt(m/k_n)    " << spring_translational << " s\n";
-  s << "  spring, rotational sqrt(I/(k_s R^2)) " << spring_rotational << " s\n";
+  s << "  spring, rotational sqrt(I/(k_s L^2)) " << spring_rotational << " s\n";
   if (rayleigh > 0) s << "  Rayleigh                             " << rayleigh << " s\n";
   if (hertz_contact_time > 0)
     s << "  Hertz contact time at " << settings.impact_velocity << " m/s        "
@@ -84,9 +84,16 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
   double lightest = inf, lightest_k = 0.0;
   double rayleigh = inf, hertz_time = inf;
 
+  // Lever of a contact about the body's centre: the radius for a sphere, the
+  // member's distance from the centre of mass plus its radius for a clump.
+  std::vector<double> lever(particles.radius);
+  const ClumpState& clumps = particles.clumps;
+  for (std::size_t m = 0; m < clumps.member_ball.size(); ++m)
+    lever[clumps.member_ball[m]] += clumps.member_offset[m].norm();
+
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const Material& mi = model.materials[particles.material[i]];
-    const double m = particles.mass[i], r = particles.radius[i];
+    const double m = particles.mass[i], r = particles.radius[i], arm = lever[i];
     const double inertia = 1.0 / particles.inv_inertia[i];
     auto consider = [&](const PairProps& p, double m_star) {
       double kn = p.kn, ks = p.ks;
@@ -99,7 +106,7 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
         hertz_time = std::min(hertz_time, hertzContactTime(m_star, c, v));
       }
       a.spring_translational = std::min(a.spring_translational, std::sqrt(m / kn));
-      a.spring_rotational = std::min(a.spring_rotational, std::sqrt(inertia / (ks * r * r)));
+      a.spring_rotational = std::min(a.spring_rotational, std::sqrt(inertia / (ks * arm * arm)));
       if (m < lightest || (m == lightest && kn > lightest_k)) {
         lightest = m;
         lightest_k = kn;

@@ -10,6 +10,7 @@
 
 #include "contact_kernel.h"
 #include "neighbor_list.h"
+#include "rigid_body.h"
 #include "wall_runtime.h"
 
 namespace rocklab::sim {
@@ -90,6 +91,9 @@ struct World::Impl {
   std::vector<Vec3> acc_force, acc_torque;
   // Observation buffers (filled only on observed steps).
   std::vector<Vec3> obs_velocity, obs_omega;
+  std::vector<Vec3> obs_clump_velocity, obs_clump_omega;
+  bool has_clumps = false;
+  bool isMember(std::size_t i) const { return has_clumps && p.clump[i] >= 0; }
   // Skin bookkeeping.
   std::vector<Vec3> ref_position;
   bool need_rebuild = true;
@@ -118,6 +122,9 @@ struct World::Impl {
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
   void assignRanges();
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
+  void clumpLoad(std::size_t c, Vec3& force, Vec3& torque) const;
+  void integrateClumps(double h, StepChecks& merged);
+  void placeMembers(std::size_t c);
   template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
   Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
   void checkOverlap(const StepChecks& checks) const;
@@ -131,7 +138,8 @@ struct World::Impl {
 // ---------------------------------------------------------------------------
 // Set-up
 
-std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres) {
+std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres,
+                          const std::vector<ClumpSpec>& clumps) {
   std::ostringstream e;
   if (model.materials.empty()) return "no materials defined";
   for (std::size_t k = 0; k < model.materials.size(); ++k) {
@@ -184,17 +192,38 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
       return e.str();
     }
   }
+  for (std::size_t c = 0; c < clumps.size(); ++c) {
+    const ClumpSpec& k = clumps[c];
+    e.str("");
+    e << "clump " << c << ": ";
+    if (k.members.empty()) return e.str() + "has no member spheres";
+    if (!(k.mass > 0)) return e.str() + "mass must be > 0 kg";
+    if (!(k.principal_inertia.minCoeff() > 0) || !k.principal_inertia.allFinite())
+      return e.str() + "principal inertia must be > 0 kg m^2";
+    if (k.material < 0 || k.material >= nm) return e.str() + "unknown material index";
+    if (!k.position.allFinite() || !k.velocity.allFinite() || !k.omega.allFinite() ||
+        !k.orientation.coeffs().allFinite() || std::abs(k.orientation.norm() - 1.0) > 1e-9)
+      return e.str() + "position, velocity and omega must be finite and the orientation a unit quaternion";
+    for (const geometry::Sphere& m : k.members)
+      if (!(m.radius > 0) || !m.centre.allFinite()) return e.str() + "member radius must be > 0 m";
+  }
   return {};
 }
 
 World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
+    : World(std::move(model), spheres, {}, threads) {}
+
+World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
+             int threads)
     : impl_(std::make_unique<Impl>()) {
-  const std::string msg = validateModel(model, spheres);
+  const std::string msg = validateModel(model, spheres, clumps);
   if (!msg.empty()) throw std::invalid_argument(msg);
   Impl& w = *impl_;
   w.model = std::move(model);
   ParticleState& p = w.p;
-  const std::size_t n = spheres.size();
+  std::size_t members = 0;
+  for (const ClumpSpec& c : clumps) members += c.members.size();
+  const std::size_t n = spheres.size() + members;
   p.position.resize(n);
   p.velocity.resize(n);
   p.omega.resize(n);
@@ -204,7 +233,7 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
   p.material.resize(n);
   p.mass.resize(n);
   p.id.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
     const SphereSpec& s = spheres[i];
     const double r = s.radius;
     const double m = w.model.materials[s.material].density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
@@ -217,6 +246,36 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
     p.inv_inertia[i] = 1.0 / (0.4 * m * r * r);  // Eq 2-8
     p.material[i] = s.material;
     p.id[i] = i;
+  }
+  if (!clumps.empty()) {
+    ClumpState& k = p.clumps;
+    p.clump.assign(n, -1);
+    k.member_begin.push_back(0);
+    std::size_t i = spheres.size();
+    for (std::size_t c = 0; c < clumps.size(); ++c) {
+      const ClumpSpec& s = clumps[c];
+      k.position.push_back(s.position);
+      k.velocity.push_back(s.velocity);
+      k.orientation.push_back(s.orientation.normalized());
+      k.angular_momentum.push_back(detail::angularMomentum(k.orientation.back(), s.principal_inertia, s.omega));
+      k.mass.push_back(s.mass);
+      k.inertia.push_back(s.principal_inertia);
+      k.id.push_back(n + c);  // ids after the balls': one id space for every body
+      for (const geometry::Sphere& m : s.members) {
+        p.radius[i] = m.radius;
+        p.mass[i] = s.mass;  // a member's dashpots and time-step criterion see the whole body
+        p.inv_mass[i] = 1.0 / s.mass;
+        p.inv_inertia[i] = 1.0 / s.principal_inertia.minCoeff();
+        p.material[i] = s.material;
+        p.id[i] = i;
+        p.clump[i] = static_cast<std::int32_t>(c);
+        k.member_ball.push_back(static_cast<std::uint32_t>(i));
+        k.member_offset.push_back(m.centre);
+        ++i;
+      }
+      k.member_begin.push_back(static_cast<std::uint32_t>(k.member_ball.size()));
+      w.placeMembers(c);
+    }
   }
   w.audit = auditTimestep(w.model, p);
   w.dt = w.audit.chosen;
@@ -263,6 +322,7 @@ World::~World() = default;
 
 void World::Impl::initialise(int requested_threads) {
   threads = requested_threads > 0 ? requested_threads : omp_get_max_threads();
+  has_clumps = p.clumps.size() > 0;
   buildPairProps();
   walls.resize(model.walls.size());
   for (std::size_t k = 0; k < walls.size(); ++k) walls[k].setup(model.walls[k]);
@@ -322,7 +382,7 @@ void World::Impl::rebuildNeighbours() {
   const std::size_t n = p.size();
   detail::PairList old = std::move(pairs);
   std::vector<Vec3> old_shear = std::move(pair_shear);
-  finder.build(p.position, p.radius, skin, teamSize(), pairs, model.max_grid_levels);
+  finder.build(p.position, p.radius, skin, teamSize(), pairs, model.max_grid_levels, p.clump);
   const std::size_t np = pairs.size();
   pair_shear.assign(np, Vec3::Zero());
   pair_touch.assign(np, 0);
@@ -516,7 +576,7 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
         acc_torque[j] += tj;
       }
       addWallForces<Law>(i, f, t, local);
-      if (integrate_now) {
+      if (integrate_now && !isMember(i)) {
         integrate(i, f, t, h, local);
       } else {
         acc_force[i] = f;
@@ -548,16 +608,88 @@ inline void World::Impl::integrate(std::size_t i, const Vec3& f_contact, const V
   c.max_disp2 = std::max(c.max_disp2, (p.position[i] - ref_position[i]).squaredNorm());
 }
 
+/// Sets the members' positions, velocities and spins from their clump's state.
+void World::Impl::placeMembers(std::size_t c) {
+  ClumpState& k = p.clumps;
+  const Quat q = k.orientation[c];
+  const Vec3 w = detail::angularVelocity(q, k.inertia[c], k.angular_momentum[c]);
+  for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+    const std::uint32_t i = k.member_ball[m];
+    const Vec3 arm = q * k.member_offset[m];
+    p.position[i] = k.position[c] + arm;
+    p.velocity[i] = k.velocity[c] + w.cross(arm);
+    p.omega[i] = w;
+  }
+}
+
+/// Resultant contact force and moment about the centre of mass (Eq 2-44, 2-46),
+/// summed over the members in their fixed order.
+void World::Impl::clumpLoad(std::size_t c, Vec3& force, Vec3& torque) const {
+  const ClumpState& k = p.clumps;
+  force.setZero();
+  torque.setZero();
+  for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+    const std::uint32_t i = k.member_ball[m];
+    force += acc_force[i];
+    torque += acc_torque[i] + (p.position[i] - k.position[c]).cross(acc_force[i]);
+  }
+}
+
+void World::Impl::integrateClumps(double h, StepChecks& merged) {
+  ClumpState& k = p.clumps;
+  const double alpha = model.contact.local_damping;
+#pragma omp parallel num_threads(teamSize())
+  {
+    StepChecks local;
+#pragma omp for schedule(static)
+    for (std::size_t c = 0; c < k.size(); ++c) {
+      Vec3 f, t;
+      clumpLoad(c, f, t);
+      f += gravity * k.mass[c];
+      if (alpha > 0) {
+        // Local damping (Eq 2-15, sign form) on the body's generalised force.
+        const Vec3 w = detail::angularVelocity(k.orientation[c], k.inertia[c], k.angular_momentum[c]);
+        for (int a = 0; a < 3; ++a) {
+          f[a] -= alpha * std::abs(f[a]) * ((k.velocity[c][a] > 0) - (k.velocity[c][a] < 0));
+          t[a] -= alpha * std::abs(t[a]) * ((w[a] > 0) - (w[a] < 0));
+        }
+      }
+      k.velocity[c] += (h / k.mass[c]) * f;     // Eq 2-11 for the body
+      k.angular_momentum[c] += h * t;           // Eq 2-45
+      k.position[c] += dt * k.velocity[c];      // Eq 2-13
+      detail::rotateFree(k.orientation[c], k.inertia[c], k.angular_momentum[c], dt);
+      placeMembers(c);
+      if (!k.position[c].allFinite() || !k.velocity[c].allFinite() || !k.angular_momentum[c].allFinite())
+        local.non_finite = true;
+      for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+        const std::uint32_t i = k.member_ball[m];
+        local.max_disp2 = std::max(local.max_disp2, (p.position[i] - ref_position[i]).squaredNorm());
+      }
+    }
+#pragma omp critical
+    mergeChecks(merged, local);
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Energy (observed steps only)
 
 template <class Law>
 Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const {
   Energy e;
+  const ClumpState& cl = p.clumps;
+  for (std::size_t c = 0; c < cl.size(); ++c) {
+    e.kinetic_translational += 0.5 * cl.mass[c] * obs_clump_velocity[c].squaredNorm();
+    const Vec3 body_w = cl.orientation[c].conjugate() * obs_clump_omega[c];
+    e.kinetic_rotational += 0.5 * body_w.dot(body_w.cwiseProduct(cl.inertia[c]));
+    e.potential_gravity -= cl.mass[c] * gravity.dot(cl.position[c]);
+  }
   for (std::size_t i = 0; i < p.size(); ++i) {
-    e.kinetic_translational += 0.5 * p.mass[i] * v[i].squaredNorm();
-    e.kinetic_rotational += 0.5 / p.inv_inertia[i] * w[i].squaredNorm();
-    e.potential_gravity -= p.mass[i] * gravity.dot(p.position[i]);
+    if (!isMember(i)) {
+      e.kinetic_translational += 0.5 * p.mass[i] * v[i].squaredNorm();
+      e.kinetic_rotational += 0.5 / p.inv_inertia[i] * w[i].squaredNorm();
+      e.potential_gravity -= p.mass[i] * gravity.dot(p.position[i]);
+    }
     for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
       if (!pair_touch[k]) continue;
       const std::uint32_t j = pairs.partner[k];
@@ -645,9 +777,10 @@ void World::Impl::checkEnergy(const Energy& e) {
     for (std::size_t i = 0; i < p.size(); ++i) {
       lo = lo.cwiseMin(p.position[i]);
       hi = hi.cwiseMax(p.position[i]);
-      mass += p.mass[i];
+      if (!isMember(i)) mass += p.mass[i];
       r_max = std::max(r_max, p.radius[i]);
     }
+    for (double m : p.clumps.mass) mass += m;
     const double extent = (hi - lo).norm() + 2 * r_max;
     energy_ref = e.total();
     energy_scale = std::abs(e.kinetic_translational + e.kinetic_rotational + e.elastic) +
@@ -686,6 +819,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     forcePass<detail::LinearLaw>(!observe, h, merged);
   else
     forcePass<detail::HertzMindlinLaw>(!observe, h, merged);
+  if (has_clumps && !observe) integrateClumps(h, merged);
   checkOverlap(merged);
 
   if (observe) {
@@ -698,6 +832,23 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
       obs_velocity[i] = p.velocity[i] + half * (acc_force[i] * p.inv_mass[i] + gravity);
       obs_omega[i] = p.omega[i] + half * p.inv_inertia[i] * acc_torque[i];
     }
+    const ClumpState& k = p.clumps;
+    obs_clump_velocity.resize(k.size());
+    obs_clump_omega.resize(k.size());
+    std::vector<Vec3> clump_force(k.size());
+    for (std::size_t c = 0; c < k.size(); ++c) {
+      Vec3 torque;
+      clumpLoad(c, clump_force[c], torque);
+      clump_force[c] += gravity * k.mass[c];
+      obs_clump_velocity[c] = k.velocity[c] + (half / k.mass[c]) * clump_force[c];
+      obs_clump_omega[c] =
+          detail::angularVelocity(k.orientation[c], k.inertia[c], k.angular_momentum[c] + half * torque);
+      for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+        const std::uint32_t i = k.member_ball[m];
+        obs_velocity[i] = obs_clump_velocity[c] + obs_clump_omega[c].cross(p.position[i] - k.position[c]);
+        obs_omega[i] = obs_clump_omega[c];
+      }
+    }
     Snapshot s;
     s.time = time;
     s.step = step;
@@ -705,13 +856,20 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     if (energy_due) checkEnergy(s.energy);
     if (observer) {
       std::vector<Vec3> total(n);  // total force including gravity
-      for (std::size_t i = 0; i < n; ++i) total[i] = acc_force[i] + gravity * p.mass[i];
+      for (std::size_t i = 0; i < n; ++i) total[i] = acc_force[i] + gravity * (isMember(i) ? 0.0 : p.mass[i]);
       s.position = p.position;
       s.velocity = obs_velocity;
       s.omega = obs_omega;
       s.force = total;
       s.radius = p.radius;
       s.id = p.id;
+      s.clump = p.clump;
+      s.clump_position = k.position;
+      s.clump_velocity = obs_clump_velocity;
+      s.clump_omega = obs_clump_omega;
+      s.clump_orientation = k.orientation;
+      s.clump_force = clump_force;
+      s.clump_id = k.id;
       for (std::uint8_t t : pair_touch) s.contacts += t;
       for (std::uint8_t t : wall_touch) s.wall_contacts += t;
       observer(s);
@@ -721,10 +879,12 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     {
       StepChecks local;
 #pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) integrate(i, acc_force[i], acc_torque[i], h, local);
+      for (std::size_t i = 0; i < n; ++i)
+        if (!isMember(i)) integrate(i, acc_force[i], acc_torque[i], h, local);
 #pragma omp critical
       mergeChecks(merged, local);
     }
+    if (has_clumps) integrateClumps(h, merged);
   }
   half_kick_pending = false;
   time = static_cast<double>(step + 1) * dt;  // no accumulated round-off in t
@@ -776,6 +936,7 @@ std::uint64_t World::stateHash() const {
   mix(impl_->p.position);
   mix(impl_->p.velocity);
   mix(impl_->p.omega);
+  mix(impl_->p.clumps.angular_momentum);
   return h;
 }
 

@@ -66,6 +66,28 @@ std::string inconsistency(const WorldState& state) {
              std::to_string(size) + " entries but particles/position has " + std::to_string(n);
     }
   }
+  const ClumpState& k = p.clumps;
+  const std::size_t nc = k.size();
+  const std::pair<const char*, std::size_t> clump_sizes[] = {{"velocity", k.velocity.size()},
+                                                             {"angular_momentum", k.angular_momentum.size()},
+                                                             {"orientation", k.orientation.size()},
+                                                             {"mass", k.mass.size()},
+                                                             {"inertia", k.inertia.size()},
+                                                             {"id", k.id.size()}};
+  for (const auto& [name, size] : clump_sizes) {
+    if (size != nc) {
+      return "inconsistent array sizes: clumps/" + std::string(name) + " has " + std::to_string(size) +
+             " entries but clumps/position has " + std::to_string(nc);
+    }
+  }
+  if (nc > 0) {
+    if (p.clump.size() != n) return "particles/clump must have one entry per particle";
+    if (k.member_begin.size() != nc + 1 || k.member_begin.back() != k.member_ball.size() ||
+        k.member_offset.size() != k.member_ball.size())
+      return "inconsistent clump member arrays";
+    for (std::uint32_t b : k.member_ball)
+      if (b >= n) return "a clump member refers to particle " + std::to_string(b) + " of " + std::to_string(n);
+  }
   for (const PairHistory& h : state.pair_history) {
     if (h.i >= n || h.j >= n) {
       return "pair history refers to particle pair (" + std::to_string(h.i) + ", " +
@@ -112,6 +134,20 @@ void writeParticles(const H5::Group& root, const ParticleState& p) {
   writeArray(group, "mass", p.mass, "kg");
   writeArray(group, "material", p.material, "");
   writeArray(group, "id", p.id, "");
+  if (p.clumps.size() == 0) return;
+  const ClumpState& k = p.clumps;
+  writeArray(group, "clump", p.clump, "");
+  const H5::Group clumps = root.createGroup("clumps");
+  writeArray(clumps, "position", k.position, "m");
+  writeArray(clumps, "velocity", k.velocity, "m/s");
+  writeArray(clumps, "angular_momentum", k.angular_momentum, "kg m^2/s");
+  writeArray(clumps, "orientation", k.orientation, "");
+  writeArray(clumps, "mass", k.mass, "kg");
+  writeArray(clumps, "inertia", k.inertia, "kg m^2");
+  writeArray(clumps, "member_begin", k.member_begin, "");
+  writeArray(clumps, "member_ball", k.member_ball, "");
+  writeArray(clumps, "member_offset", k.member_offset, "m");
+  writeArray(clumps, "id", k.id, "");
 }
 
 void writeFile(const std::filesystem::path& path, const WorldState& state,
@@ -172,6 +208,8 @@ class Reader {
     stored.read(nativeScalarType<T>(), &value);
     return value;
   }
+
+  bool has(const std::string& name) const { return file_.nameExists(name); }
 
   std::string text(const std::string& name) const {
     const H5::DataSet dataset = openDataSet(name);
@@ -263,6 +301,19 @@ ParticleState readParticles(const Reader& in) {
   p.mass = in.array<double>("/particles/mass");
   p.material = in.array<std::int32_t>("/particles/material");
   p.id = in.array<std::uint64_t>("/particles/id");
+  if (!in.has("/clumps")) return p;  // a sphere-only run
+  p.clump = in.array<std::int32_t>("/particles/clump");
+  ClumpState& k = p.clumps;
+  k.position = in.array<Vec3>("/clumps/position");
+  k.velocity = in.array<Vec3>("/clumps/velocity");
+  k.angular_momentum = in.array<Vec3>("/clumps/angular_momentum");
+  k.orientation = in.array<Quat>("/clumps/orientation");
+  k.mass = in.array<double>("/clumps/mass");
+  k.inertia = in.array<Vec3>("/clumps/inertia");
+  k.member_begin = in.array<std::uint32_t>("/clumps/member_begin");
+  k.member_ball = in.array<std::uint32_t>("/clumps/member_ball");
+  k.member_offset = in.array<Vec3>("/clumps/member_offset");
+  k.id = in.array<std::uint64_t>("/clumps/id");
   return p;
 }
 

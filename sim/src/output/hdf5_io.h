@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rocklab/sim/particles.h"  // sim::Vec3
+#include "rocklab/sim/particles.h"  // sim::Vec3, sim::Quat
 
 namespace rocklab::sim::output::detail {
 
@@ -46,6 +46,14 @@ template <>
 struct Layout<Vec3> {
   static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
   static constexpr hsize_t columns = 3;
+};
+
+// A quaternion is stored as [n,4] doubles in Eigen's order x, y, z, w.
+static_assert(sizeof(Quat) == 4 * sizeof(double));
+template <>
+struct Layout<Quat> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_DOUBLE; }
+  static constexpr hsize_t columns = 4;
 };
 
 inline H5::StrType textType() {

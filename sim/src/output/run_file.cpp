@@ -131,6 +131,14 @@ void RunFile::writeFrame(const Snapshot& snapshot) {
     writeArray(frame, "force", snapshot.force, "N");
     writeArray(frame, "radius", snapshot.radius, "m");
     writeArray(frame, "id", snapshot.id, "");
+    if (!snapshot.clump_id.empty()) {
+      writeArray(frame, "clump", snapshot.clump, "");
+      writeArray(frame, "clump_position", snapshot.clump_position, "m");
+      writeArray(frame, "clump_velocity", snapshot.clump_velocity, "m/s");
+      writeArray(frame, "clump_omega", snapshot.clump_omega, "rad/s");
+      writeArray(frame, "clump_orientation", snapshot.clump_orientation, "");
+      writeArray(frame, "clump_id", snapshot.clump_id, "");
+    }
     // Flushing makes the frame (and the energy rows before it) survive a kill.
     impl_->file.flush(H5F_SCOPE_GLOBAL);
   });

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rocklab/geometry/packing.h"  // geometry::Sphere
 #include "rocklab/geometry/triangle_mesh.h"
 #include "rocklab/geometry/vec.h"
 
@@ -107,6 +108,21 @@ struct SphereSpec {
   geometry::Vec3 velocity = geometry::Vec3::Zero();  // m/s
   geometry::Vec3 omega = geometry::Vec3::Zero();     // rad/s
   double radius = 0.01;                              // m
+  int material = 0;
+};
+
+/// A rigid clump to add to a world: member spheres in the body frame, whose axes
+/// are the principal axes and whose origin is the centre of mass (build it with
+/// geometry::clumpMassProperties). Member balls take `material` for contacts;
+/// mass and inertia are the clump's (its density is not used).
+struct ClumpSpec {
+  geometry::Vec3 position = geometry::Vec3::Zero();        // m, centre of mass
+  geometry::Quat orientation = geometry::Quat::Identity();  // body -> world
+  geometry::Vec3 velocity = geometry::Vec3::Zero();        // m/s
+  geometry::Vec3 omega = geometry::Vec3::Zero();           // rad/s, world frame
+  double mass = 0.0;                                       // kg
+  geometry::Vec3 principal_inertia = geometry::Vec3::Zero();  // kg m^2
+  std::vector<geometry::Sphere> members;                   // body frame, m
   int material = 0;
 };
 

@@ -1,7 +1,9 @@
 #pragma once
 // What observers (output writers, energy log, watchdog) see at a whole step t:
 // positions at t and velocities synchronised to t (v(t) = v(t - dt/2) + a(t) dt/2,
-// the velocity-Verlet value), with the total force and torque at t.
+// the velocity-Verlet value), with the total force and torque at t. Member
+// balls of a clump carry the clump's motion; their `force` is the contact force
+// on that member alone (gravity acts on the clump, see clump_force).
 #include <cstdint>
 #include <span>
 
@@ -28,6 +30,14 @@ struct Snapshot {
   std::span<const geometry::Vec3> force;     // [n] N, total including gravity
   std::span<const double> radius;            // [n] m
   std::span<const std::uint64_t> id;         // [n]
+  // Rigid clumps (all empty without clumps). Member balls appear above too.
+  std::span<const std::int32_t> clump;                 // [n] owning clump or -1
+  std::span<const geometry::Vec3> clump_position;      // [c] m, centre of mass
+  std::span<const geometry::Vec3> clump_velocity;      // [c] m/s, synchronised to `time`
+  std::span<const geometry::Vec3> clump_omega;         // [c] rad/s, synchronised to `time`
+  std::span<const geometry::Quat> clump_orientation;   // [c] body -> world
+  std::span<const geometry::Vec3> clump_force;         // [c] N, total including gravity
+  std::span<const std::uint64_t> clump_id;             // [c]
   Energy energy;
   std::size_t contacts = 0;       // touching ball–ball pairs
   std::size_t wall_contacts = 0;  // touching ball–wall pairs

@@ -32,7 +32,7 @@ double dampingFromRestitution(double restitution);
 
 struct TimestepAudit {
   double spring_translational = 0.0;  // s  sqrt(m/k_n), stiffest pair of the lightest body
-  double spring_rotational = 0.0;     // s  sqrt(I/(k_s R^2))
+  double spring_rotational = 0.0;     // s  sqrt(I/(k_s L^2)), L = lever (R for a sphere)
   double critical = 0.0;              // s  min of the two
   double rayleigh = 0.0;              // s  0 when no shear modulus is given (linear law)
   double hertz_contact_time = 0.0;    // s  at impact_velocity; 0 for the linear law

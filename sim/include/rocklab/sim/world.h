@@ -10,7 +10,9 @@
 //   4. gather       sum each ball's contact forces in a fixed order (bitwise
 //                   identical for any thread count)
 //   5. observe      only on steps an observer asked for: synchronised snapshot
-//   6. integrate    leapfrog kick and drift (Eq 2-11..2-13), NaN guard
+//   6. integrate    leapfrog kick and drift (Eq 2-11..2-13), NaN guard; clumps
+//                   sum their members' forces and moments (Eq 2-44, 2-46) and
+//                   move as rigid bodies (src/rigid_body.h), members follow
 //   7. watchdog     overlap limit every step, energy every check_interval steps
 //
 // Threads: stages 3, 4 and 6 run over balls with OpenMP static schedules; every
@@ -70,6 +72,9 @@ class World {
   /// Builds a world; validates the model, audits the time step (throws
   /// std::invalid_argument with the reason when the model or dt is unusable).
   World(Model model, const std::vector<SphereSpec>& spheres, int threads = 0);
+  /// The same with rigid clumps; their member balls follow the free spheres.
+  World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
+        int threads = 0);
   /// Restarts from a saved state (dt is taken from the state).
   World(Model model, WorldState state, int threads = 0);
   ~World();
@@ -101,7 +106,8 @@ class World {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Validates a model and its spheres; returns "" or a message naming the field.
-std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres);
+/// Validates a model, its spheres and clumps; returns "" or a message naming the field.
+std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres,
+                          const std::vector<ClumpSpec>& clumps = {});
 
 }  // namespace rocklab::sim

@@ -8,6 +8,9 @@
 //   /frames/000000, ...    one group per frame, attrs time (s), step;
 //                          datasets position [n,3] m, velocity [n,3] m/s, omega [n,3] rad/s,
 //                          force [n,3] N, radius [n] m, id [n] uint64
+//                          with clumps also: clump [n] int32 (owning clump, -1 free),
+//                          clump_position [c,3] m, clump_velocity [c,3] m/s, clump_omega [c,3]
+//                          rad/s, clump_orientation [c,4] (x, y, z, w; body -> world), clump_id [c]
 //   /energy                [rows, 8] double, extendible and chunked; columns (attr "columns"):
 //                          time s, step, kinetic_translational J, kinetic_rotational J,
 //                          potential_gravity J, elastic J, total J, contacts
