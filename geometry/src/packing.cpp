@@ -3,6 +3,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "sphere_hash_grid.h"
+
 namespace rocklab::geometry {
 
 std::vector<Vec3> latticePoints(LatticeKind kind, double cell, const Vec3& offset, const Vec3& corner,
@@ -36,44 +38,12 @@ std::uint64_t Rng::next() {
 
 double Rng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
 
-namespace {
-// Hash grid over placed spheres for overlap queries.
-struct HashGrid {
-  double cell;
-  std::unordered_map<std::int64_t, std::vector<Sphere>> cells;
-  static std::int64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
-    return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
-  }
-  std::array<std::int64_t, 3> index(const Vec3& p) const {
-    return {static_cast<std::int64_t>(std::floor(p.x() / cell)),
-            static_cast<std::int64_t>(std::floor(p.y() / cell)),
-            static_cast<std::int64_t>(std::floor(p.z() / cell))};
-  }
-  void insert(const Sphere& s) {
-    const auto c = index(s.centre);
-    cells[key(c[0], c[1], c[2])].push_back(s);
-  }
-  bool overlaps(const Vec3& p, double r) const {
-    const auto c = index(p);
-    for (std::int64_t dz = -1; dz <= 1; ++dz)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dx = -1; dx <= 1; ++dx) {
-          const auto it = cells.find(key(c[0] + dx, c[1] + dy, c[2] + dz));
-          if (it == cells.end()) continue;
-          for (const Sphere& s : it->second)
-            if ((s.centre - p).squaredNorm() < (s.radius + r) * (s.radius + r)) return true;
-        }
-    return false;
-  }
-};
-}  // namespace
-
 std::vector<Vec3> randomNonOverlapping(const std::vector<double>& radii, const Vec3& lo, const Vec3& hi,
                                        const std::vector<Sphere>& existing, Rng& rng, int max_attempts) {
   double r_max = 0;
   for (double r : radii) r_max = std::max(r_max, r);
   for (const Sphere& s : existing) r_max = std::max(r_max, s.radius);
-  HashGrid grid{2.0 * r_max, {}};
+  detail::SphereHashGrid grid{2.0 * r_max, {}};
   // Spheres larger than a cell would be missed by the 27-cell query: the cell is
   // set by the largest radius, so every overlap partner is in a neighbour cell.
   for (const Sphere& s : existing) grid.insert(s);
