@@ -6,6 +6,7 @@ find_package(nlohmann_json 3 REQUIRED)           # nlohmann_json::nlohmann_json
 find_package(tomlplusplus REQUIRED)              # tomlplusplus::tomlplusplus
 find_package(fmt REQUIRED)                       # fmt::fmt
 find_package(assimp REQUIRED)                    # assimp::assimp
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs)  # ${OpenCV_LIBS} (plots; tracking later)
 # List the VTK components: without them find_package(VTK) looks for Qt5 and fails.
 find_package(VTK 9.1 REQUIRED COMPONENTS IOXML CommonCore CommonDataModel)
 # FindHDF5 picks the serial build even when VTK pulled in the OpenMPI one.

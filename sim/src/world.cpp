@@ -291,7 +291,7 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
   w.time = state.time;
   w.step = state.step;
   w.half_kick_pending = state.half_kick_pending;
-  w.audit = auditTimestep(w.model, w.p);
+  if (w.p.size() > 0) w.audit = auditTimestep(w.model, w.p);  // nothing to audit in an empty world
   w.audit.chosen = state.dt;  // the run continues with the step it had
   w.dt = state.dt;
   w.initialise(threads);

@@ -194,3 +194,36 @@ TEST_CASE("clump: bitwise identical on 1 and 2 threads and across a restart", "[
   while (second.stepCount() < 400) second.step();
   CHECK(second.stateHash() == hash[0]);
 }
+
+TEST_CASE("clump: removing a member removes its clump and keeps the rest running", "[clump]") {
+  auto model = test::linearModel(1e6, 0.4, 0.1);
+  model.gravity = Vec3(0, 0, -9.81);
+  model.walls.push_back(test::floorPlane());
+  std::vector<sim::SphereSpec> spheres = {test::sphere(Vec3(0.1, 0, 0.01), 0.01),
+                                          test::sphere(Vec3(0.1, 0, 0.0301), 0.01)};
+  std::vector<sim::ClumpSpec> clumps = {fourBall(0.00735, 2730, Vec3(0, 0, 0.0074)),
+                                        fourBall(0.00735, 2730, Vec3(0, 0.04, 0.0074))};
+  sim::World w(model, spheres, clumps, 1);
+  for (int k = 0; k < 2000; ++k) w.step();
+  sim::WorldState s = w.exportState();
+  REQUIRE(s.particles.size() == 10);
+  std::vector<bool> remove(10, false);
+  remove[0] = true;  // the lower free sphere
+  remove[3] = true;  // the second member of the first clump
+  const sim::WorldState cut = sim::withoutBalls(s, remove);
+  const auto& p = cut.particles;
+  REQUIRE(p.size() == 5);  // one free sphere and one whole clump
+  CHECK(p.id[0] == 1);
+  CHECK(p.clumps.size() == 1);
+  CHECK(p.clumps.id[0] == s.particles.clumps.id[1]);
+  CHECK(p.clumps.member_ball == std::vector<std::uint32_t>{1, 2, 3, 4});
+  CHECK(p.clump == std::vector<std::int32_t>{-1, 0, 0, 0, 0});
+  for (const auto& h : cut.pair_history) CHECK((h.i < 5 && h.j < 5 && h.i < h.j));
+  for (const auto& h : cut.wall_history) CHECK(h.particle < 5);
+  sim::World rest(model, cut, 1);
+  const Vec3 before = rest.particles().clumps.position[0];
+  while (rest.time() < w.time() + 0.5) rest.step();
+  // The upper sphere falls onto the floor; the remaining clump stays where it lay.
+  CHECK(rest.particles().position[0].z() == Approx(0.01).margin(1e-4));
+  CHECK((rest.particles().clumps.position[0] - before).norm() < 1e-4);
+}

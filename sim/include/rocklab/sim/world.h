@@ -106,6 +106,13 @@ class World {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Removes balls from a saved state, together with the whole clump of any
+/// removed member; indices in the contact history are renumbered and ids kept.
+/// A World rebuilt from the result (World(model, state)) continues the run
+/// without them: this is how experiments drop discharged pebbles or the clumps
+/// cut by a plate added after deposition.
+WorldState withoutBalls(WorldState state, std::vector<bool> remove);
+
 /// Validates a model, its spheres and clumps; returns "" or a message naming the field.
 std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres,
                           const std::vector<ClumpSpec>& clumps = {});

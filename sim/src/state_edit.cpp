@@ -1,0 +1,95 @@
+// Removal of bodies from a saved state (see withoutBalls in world.h).
+#include <cstdint>
+#include <stdexcept>
+
+#include "rocklab/sim/world.h"
+
+namespace rocklab::sim {
+
+namespace {
+
+/// Keeps the entries of `v` whose flag in `keep` is set, in order.
+template <class T>
+void compact(std::vector<T>& v, const std::vector<bool>& keep) {
+  std::size_t out = 0;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (keep[k]) v[out++] = v[k];
+  v.resize(out);
+}
+
+}  // namespace
+
+WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
+  ParticleState& p = state.particles;
+  const std::size_t n = p.size();
+  if (remove.size() != n) throw std::invalid_argument("withoutBalls: one flag per ball is needed");
+  ClumpState& k = p.clumps;
+  // A clump goes whole: one removed member removes all.
+  std::vector<bool> keep_clump(k.size(), true);
+  for (std::size_t c = 0; c < k.size(); ++c) {
+    for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m)
+      if (remove[k.member_ball[m]]) keep_clump[c] = false;
+    if (!keep_clump[c])
+      for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) remove[k.member_ball[m]] = true;
+  }
+  std::vector<bool> keep(n);
+  std::vector<std::uint32_t> new_index(n, UINT32_MAX);
+  std::uint32_t next = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    keep[i] = !remove[i];
+    if (keep[i]) new_index[i] = next++;
+  }
+  compact(p.position, keep);
+  compact(p.velocity, keep);
+  compact(p.omega, keep);
+  compact(p.radius, keep);
+  compact(p.inv_mass, keep);
+  compact(p.inv_inertia, keep);
+  compact(p.material, keep);
+  compact(p.mass, keep);
+  compact(p.id, keep);
+  if (k.size() > 0) {
+    std::vector<std::int32_t> new_clump(k.size(), -1);
+    std::int32_t next_clump = 0;
+    for (std::size_t c = 0; c < k.size(); ++c)
+      if (keep_clump[c]) new_clump[c] = next_clump++;
+    compact(p.clump, keep);
+    for (std::int32_t& c : p.clump)
+      if (c >= 0) c = new_clump[static_cast<std::size_t>(c)];
+    std::vector<std::uint32_t> begin{0}, ball;
+    std::vector<Vec3> offset;
+    for (std::size_t c = 0; c < k.size(); ++c) {
+      if (!keep_clump[c]) continue;
+      for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+        ball.push_back(new_index[k.member_ball[m]]);
+        offset.push_back(k.member_offset[m]);
+      }
+      begin.push_back(static_cast<std::uint32_t>(ball.size()));
+    }
+    k.member_begin = std::move(begin);
+    k.member_ball = std::move(ball);
+    k.member_offset = std::move(offset);
+    compact(k.position, keep_clump);
+    compact(k.velocity, keep_clump);
+    compact(k.angular_momentum, keep_clump);
+    compact(k.orientation, keep_clump);
+    compact(k.mass, keep_clump);
+    compact(k.inertia, keep_clump);
+    compact(k.id, keep_clump);
+    if (k.size() == 0) {
+      p.clump.clear();
+      k = ClumpState{};
+    }
+  }
+  std::vector<PairHistory> pairs;
+  for (const PairHistory& h : state.pair_history)
+    if (keep[h.i] && keep[h.j]) pairs.push_back({new_index[h.i], new_index[h.j], h.shear});
+  state.pair_history = std::move(pairs);
+  std::vector<WallHistory> walls;
+  for (const WallHistory& h : state.wall_history)
+    if (keep[h.particle]) walls.push_back({new_index[h.particle], h.wall, h.shear});
+  state.wall_history = std::move(walls);
+  return state;
+}
+
+}  // namespace rocklab::sim
