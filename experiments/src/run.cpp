@@ -14,6 +14,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "experiment.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/output/run_file.h"
 #include "rocklab/sim/output/vtk_series.h"
@@ -112,7 +113,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
       out::Checkpoint cp = out::readCheckpoint(options.restart);
       world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
     } else {
-      world = std::make_unique<sim::World>(scene.model, scene.spheres, options.threads);
+      world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, options.threads);
     }
   } catch (const out::CheckpointError& e) {
     log << "error: " << e.what() << "\n";
@@ -120,6 +121,12 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   } catch (const std::invalid_argument& e) {
     log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string()) << ": "
         << e.what() << "\n";
+    return kExitBadInput;
+  }
+  std::unique_ptr<Experiment> experiment = makeExperiment(scene);
+  if (experiment && !options.restart.empty()) {
+    log << "error: " << scene.source.string() << ": experiment." << scene.experiment.type
+        << " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not saved); run the scene again\n";
     return kExitBadInput;
   }
   const double dt = world->dt();
@@ -153,16 +160,25 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     if (anyWall([shape = shape](const sim::Wall& w) { return w.shape == shape; })) modules.push_back(name);
   if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); })) modules.push_back("walls:moving");
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
+  if (world->particles().clumps.size() > 0) modules.push_back("clumps");
+  if (experiment) modules.push_back("experiment:" + scene.experiment.type);
   if (scene.run.hdf5) modules.push_back("output:hdf5");
   if (scene.run.vtk) modules.push_back("output:vtk");
   if (scene.run.checkpoint) modules.push_back("output:checkpoint");
 
   log << "rocklab: scene '" << scene.run.name << "'" << (options.restart.empty() ? "" : " (restart)") << ", "
-      << world->particles().size() << " spheres, " << model.walls.size() << " walls, threads: "
+      << world->particles().size() << " balls (" << world->particles().clumps.size() << " clumps), "
+      << model.walls.size() << " walls, threads: "
       << world->threads() << "\n";
   log << "  modules: ";
   for (std::size_t k = 0; k < modules.size(); ++k) log << (k ? ", " : "") << modules[k];
-  log << "\n" << world->timestepAudit().describe(model.timestep) << "\n";
+  log << "\n";
+  for (const ClumpShapeReport& c : scene.clump_shapes)
+    log << "  clump shape of " << c.source << ": " << c.shape << ", " << c.members << " members, mass "
+        << c.mass * 1e3 << " g (" << c.distribution << " distribution), volume " << c.volume * 1e9
+        << " mm^3 (equivalent diameter " << c.equivalent_diameter * 1e3 << " mm); true union volume "
+        << c.union_volume * 1e9 << " +- " << c.union_volume_error * 1e9 << " mm^3\n";
+  log << world->timestepAudit().describe(model.timestep) << "\n";
   log << "  steps: " << total_steps << " from t = " << world->time() << " s, output to " << options.out_dir.string()
       << "\n";
 
@@ -179,7 +195,10 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   sim::Snapshot last;  // figures of the last observed step
   std::size_t frames = 0;
   bool frame_due = false;  // set by the loop before an observed step
+  bool experiment_due = false, energy_due = false;
   auto observer = [&](const sim::Snapshot& s) {
+    if (experiment_due) experiment->observe(s);
+    if (!frame_due && !energy_due) return;
     const auto t0 = Clock::now();
     last.time = s.time;
     last.step = s.step;
@@ -205,6 +224,8 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   const std::uint64_t first_step = world->stepCount();
   const std::uint64_t end_step = std::max(total_steps, first_step);
   const auto t_loop = Clock::now();
+  const ExperimentContext context{options.threads, &log};
+  bool experiment_over = false;
   try {
     while (world->stepCount() < end_step) {
       if (g_stop) {
@@ -212,16 +233,20 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
         exit_code = kExitInterrupted;
         break;
       }
-      // Frames at t = 0, every frame interval and at the last step; energy rows
-      // at frames and every energy interval.
+      if (experiment && !experiment_over) experiment_over = !experiment->advance(world, context);
+      // Frames at t = 0, every frame interval and at the last step (or the step
+      // the experiment ended); energy rows at frames and every energy interval.
       const std::uint64_t k = world->stepCount();
-      frame_due = k == first_step || k + 1 >= end_step || (frame_every && k % frame_every == 0);
-      if (frame_due || (energy_every && k % energy_every == 0))
+      frame_due = k == first_step || k + 1 >= end_step || experiment_over || (frame_every && k % frame_every == 0);
+      experiment_due = experiment && !experiment_over && experiment->wantsSnapshot(k);
+      energy_due = energy_every && k % energy_every == 0;
+      if (frame_due || experiment_due || energy_due)
         world->step(observer);
       else
         world->step();
       if (checkpoint_every && world->stepCount() % checkpoint_every == 0) writeCheckpoint();
-      progress.update(world->stepCount(), "");
+      progress.update(world->stepCount(), experiment ? experiment->progress() : "");
+      if (experiment_over) break;
     }
   } catch (const sim::WatchdogError& e) {
     status = "stopped_by_watchdog";
@@ -244,6 +269,22 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   r["status"] = status;
   if (!message.empty()) r["message"] = message;
   r["particles"] = world->particles().size();
+  r["clumps"] = world->particles().clumps.size();
+  if (!scene.clump_shapes.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const ClumpShapeReport& c : scene.clump_shapes)
+      list.push_back({{"source", c.source},
+                        {"shape", c.shape},
+                        {"members", c.members},
+                        {"mass_kg", c.mass},
+                        {"volume_m3", c.volume},
+                        {"equivalent_diameter_m", c.equivalent_diameter},
+                        {"union_volume_m3", c.union_volume},
+                        {"union_volume_error_m3", c.union_volume_error},
+                        {"mass_distribution", c.distribution},
+                        {"principal_inertia_kg_m2", {c.principal_inertia.x(), c.principal_inertia.y(), c.principal_inertia.z()}}});
+    r["clump_shapes"] = list;
+  }
   r["walls"] = model.walls.size();
   r["threads"] = world->threads();
   r["modules"] = modules;
@@ -282,6 +323,11 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
                   {"frames", frames},
                   {"vtk_frames", vtk_frames},
                   {"checkpoint", scene.run.checkpoint && exit_code != kExitWatchdog ? "checkpoint.h5" : ""}};
+  if (experiment) {
+    r["experiment"] = scene.experiment.type;
+    if (status == "completed" && !experiment_over) r["experiment_status"] = "time limit (scene.end_time) reached first";
+    experiment->report(r, options.out_dir, log);
+  }
   writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
 
   if (!message.empty()) log << "error: " << message << "\n";

@@ -1,9 +1,13 @@
 #include "rocklab/experiments/scene.h"
 
+#include <cmath>
+#include <algorithm>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 
+#include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/mesh_import.h"
 #include "rocklab/geometry/packing.h"
 #include "toml_reader.h"
@@ -120,17 +124,104 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
   }
 }
 
-void readParticles(TableReader& root, const std::map<std::string, int>& materials, std::uint64_t seed,
-                   std::vector<sim::SphereSpec>& spheres) {
+/// A body shape of one particle source: a sphere, or a clump with its members
+/// in the principal frame centred on the centre of mass.
+struct BodyShape {
+  std::vector<geometry::Sphere> members;  // empty for a sphere
+  double mass = 0;
+  Vec3 inertia = Vec3::Zero();
+};
+
+/// Reads `shape` and its size keys; fills `report` for clumps.
+BodyShape readClumpShape(TableReader& t, const std::string& shape, double density,
+                         const std::filesystem::path& base_dir, ClumpShapeReport& report) {
+  std::vector<geometry::Sphere> members;
+  std::string default_volume = "union";
+  if (shape == "four_ball") {
+    if (t.has("member_radius") == t.has("equivalent_diameter"))
+      t.fail("member_radius", "give exactly one of member_radius (m) and equivalent_diameter (m, Eq 4-2 sizing)");
+    const double r = t.has("member_radius") ? t.number("member_radius", 0, Range::positive())
+                                            : geometry::fourBallRadiusForEquivalentDiameter(
+                                                  t.number("equivalent_diameter", 0, Range::positive()));
+    members = geometry::fourBallClump(r);
+    default_volume = "eq42";  // the study sized its clumps with Eq 4-2
+    report.shape = "four_ball";
+  } else {
+    const std::filesystem::path file = base_dir / t.requiredString("file");
+    const double scale = t.number("scale", 1.0, Range::positive());
+    try {
+      members = geometry::readClumpFile(file.string());
+    } catch (const std::exception& e) {
+      t.fail("file", e.what());
+    }
+    for (auto& m : members) {
+      m.centre *= scale;
+      m.radius *= scale;
+    }
+    report.shape = file.string();
+  }
+  const std::string distribution = t.string("mass_distribution", "union", {"union", "equal_mass", "sum"});
+  const auto dist = distribution == "union"        ? geometry::ClumpMassDistribution::Union
+                    : distribution == "equal_mass" ? geometry::ClumpMassDistribution::EqualMass
+                                                   : geometry::ClumpMassDistribution::Sum;
+  double total_mass = t.number("mass", 0.0, Range::nonNegative());
+  const std::string volume = t.string("mass_volume", default_volume, {"eq42", "union", "sum"});
+  if (total_mass > 0 && t.has("mass_volume")) t.fail("mass", "give mass (kg) or mass_volume, not both");
+  if (volume == "eq42" && shape != "four_ball") t.fail("mass_volume", "\"eq42\" applies to the four-ball clump only");
+  auto props = geometry::clumpMassProperties(members, density, dist);
+  if (total_mass == 0) {
+    double v = props.union_volume;
+    if (volume == "eq42") v = geometry::fourBallVolumeEq42(members.front().radius);
+    if (volume == "sum") {
+      v = 0;
+      for (const auto& m : members) v += 4.0 / 3.0 * std::numbers::pi * std::pow(m.radius, 3);
+    }
+    total_mass = density * v;
+  }
+  props = geometry::clumpMassProperties(members, density, dist, total_mass);
+  BodyShape body;
+  body.mass = props.mass;
+  body.inertia = props.principal_moments;
+  for (const auto& m : members)
+    body.members.push_back({props.principal_axes.transpose() * (m.centre - props.centre_of_mass), m.radius});
+  report.members = members.size();
+  report.mass = props.mass;
+  report.volume = props.mass / density;
+  report.union_volume = props.union_volume;
+  report.union_volume_error = props.union_volume_error;
+  report.equivalent_diameter = std::cbrt(6.0 * report.volume / std::numbers::pi);
+  report.distribution = distribution;
+  report.principal_inertia = props.principal_moments;
+  return body;
+}
+
+void readParticles(TableReader& root, const std::map<std::string, int>& materials,
+                   const std::vector<sim::Material>& material_list, std::uint64_t seed,
+                   const std::filesystem::path& base_dir, Scene& scene) {
+  std::vector<sim::SphereSpec>& spheres = scene.spheres;
   std::size_t source_index = 0;
+  // Every ball placed so far (clump members in world position), for insertion.
+  std::vector<geometry::Sphere> placed;
   for (TableReader t : root.tableArray("particles")) {
     const std::string type = t.requiredString("type", {"lattice", "random", "list"});
     const int material = materialIndex(t, materials);
     const Vec3 velocity = t.vec3("velocity", Vec3::Zero());
+    const std::string shape = t.string("shape", "sphere", {"sphere", "four_ball", "file"});
+    // Each source has its own stream, so adding a source does not move the others.
+    geometry::Rng rng(seed * 1000003ull + source_index);
+    BodyShape body;
+    if (shape != "sphere") {
+      ClumpShapeReport report;
+      report.source = t.path();
+      body = readClumpShape(t, shape, material_list[static_cast<std::size_t>(material)].density, base_dir, report);
+      scene.clump_shapes.push_back(report);
+    }
+    const bool clumps = !body.members.empty();
     std::vector<Vec3> points;
     std::vector<double> radii;
+    std::vector<geometry::Quat> orientations;
     if (type == "lattice") {
-      const double radius = t.requiredNumber("radius", Range::positive());
+      const double radius = clumps ? 0.0 : t.requiredNumber("radius", Range::positive());
       const std::string kind = t.string("lattice", "sc", {"sc", "bcc", "fcc"});
       const double cell = t.requiredNumber("cell", Range::positive());
       const Vec3 offset = t.vec3("offset", Vec3::Zero());
@@ -149,62 +240,134 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
       radii.assign(points.size(), radius);
     } else if (type == "random") {
       const auto count = t.integer("count", 0, Range::closed(1, 1e7));
-      if (!t.has("count")) t.fail("count", "missing; the number of spheres to insert is required");
-      double r_min, r_max;
-      if (t.has("radius")) {
-        r_min = r_max = t.number("radius", 0, Range::positive());
-      } else {
-        r_min = t.requiredNumber("radius_min", Range::positive());
-        r_max = t.requiredNumber("radius_max", Range::positive());
-        if (r_max < r_min) t.fail("radius_max", "must be >= radius_min");
-      }
+      if (!t.has("count")) t.fail("count", "missing; the number of particles to insert is required");
       const Vec3 lo = t.requiredVec3("region_min"), hi = t.requiredVec3("region_max");
-      if (!((hi - lo).minCoeff() > 2 * r_max)) t.fail("region_max", "the region must be wider than a sphere");
-      // Each source has its own stream, so adding a source does not move the others.
-      geometry::Rng rng(seed * 1000003ull + source_index);
-      for (std::int64_t k = 0; k < count; ++k) radii.push_back(rng.uniform(r_min, r_max));
-      std::vector<geometry::Sphere> existing;
-      for (const auto& s : spheres) existing.push_back({s.position, s.radius});
-      points = geometry::randomNonOverlapping(radii, lo, hi, existing, rng);
-      if (points.size() < radii.size())
-        t.fail("count", "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
-                            " spheres fit in the region without overlap; enlarge region_min/region_max or lower count");
+      if (clumps) {
+        const std::vector<const std::vector<geometry::Sphere>*> shapes(static_cast<std::size_t>(count), &body.members);
+        const auto poses = geometry::randomNonOverlappingBodies(shapes, lo, hi, placed, rng);
+        if (poses.size() < shapes.size())
+          t.fail("count", "only " + std::to_string(poses.size()) + " of " + std::to_string(shapes.size()) +
+                              " clumps fit in the region without overlap; enlarge region_min/region_max or lower count");
+        for (const auto& pose : poses) {
+          points.push_back(pose.position);
+          orientations.push_back(pose.orientation);
+        }
+      } else {
+        double r_min, r_max;
+        if (t.has("radius")) {
+          r_min = r_max = t.number("radius", 0, Range::positive());
+        } else {
+          r_min = t.requiredNumber("radius_min", Range::positive());
+          r_max = t.requiredNumber("radius_max", Range::positive());
+          if (r_max < r_min) t.fail("radius_max", "must be >= radius_min");
+        }
+        if (!((hi - lo).minCoeff() > 2 * r_max)) t.fail("region_max", "the region must be wider than a sphere");
+        for (std::int64_t k = 0; k < count; ++k) radii.push_back(rng.uniform(r_min, r_max));
+        points = geometry::randomNonOverlapping(radii, lo, hi, placed, rng);
+        if (points.size() < radii.size())
+          t.fail("count", "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
+                              " spheres fit in the region without overlap; enlarge region_min/region_max or lower count");
+      }
     } else {
       points = t.vec3List("positions");
       if (points.empty()) t.fail("positions", "a list needs positions = [[x, y, z], ...]");
-      if (t.has("radii")) {
+      if (clumps) {
+        radii.assign(points.size(), 0.0);
+      } else if (t.has("radii")) {
         radii = t.numberList("radii", Range::positive());
         if (radii.size() != points.size()) t.fail("radii", "needs one radius per position");
       } else {
         radii.assign(points.size(), t.requiredNumber("radius", Range::positive()));
       }
-      const auto velocities = t.vec3List("velocities");
+    }
+    std::vector<Vec3> velocities, omegas;
+    if (type == "list") {
+      velocities = t.vec3List("velocities");
       if (!velocities.empty() && velocities.size() != points.size())
         t.fail("velocities", "needs one velocity per position");
-      const auto omegas = t.vec3List("omegas");
+      omegas = t.vec3List("omegas");
       if (!omegas.empty() && omegas.size() != points.size()) t.fail("omegas", "needs one per position");
-      for (std::size_t k = 0; k < points.size(); ++k) {
+    }
+    // Clumps not placed by the random insertion get random orientations too.
+    if (clumps && t.boolean("random_orientation", true))
+      while (orientations.size() < points.size()) orientations.push_back(geometry::randomRotation(rng));
+    while (orientations.size() < points.size()) orientations.push_back(geometry::Quat::Identity());
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const Vec3 v = velocities.empty() ? velocity : velocities[k];
+      const Vec3 w = omegas.empty() ? Vec3::Zero() : omegas[k];
+      if (clumps) {
+        sim::ClumpSpec c;
+        c.position = points[k];
+        c.orientation = orientations[k];
+        c.velocity = v;
+        c.omega = w;
+        c.mass = body.mass;
+        c.principal_inertia = body.inertia;
+        c.members = body.members;
+        c.material = material;
+        for (const auto& m : body.members) placed.push_back({points[k] + orientations[k] * m.centre, m.radius});
+        scene.clumps.push_back(std::move(c));
+      } else {
         sim::SphereSpec s;
         s.position = points[k];
         s.radius = radii[k];
         s.material = material;
-        s.velocity = velocities.empty() ? velocity : velocities[k];
-        s.omega = omegas.empty() ? Vec3::Zero() : omegas[k];
+        s.velocity = v;
+        s.omega = w;
+        placed.push_back({s.position, s.radius});
         spheres.push_back(s);
       }
-      points.clear();
-    }
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      sim::SphereSpec s;
-      s.position = points[k];
-      s.radius = radii[k];
-      s.material = material;
-      s.velocity = velocity;
-      spheres.push_back(s);
     }
     t.finish();
     ++source_index;
   }
+}
+
+/// Names of the walls, for messages.
+std::vector<std::string> wallNames(const sim::Model& model) {
+  std::vector<std::string> names;
+  for (const auto& w : model.walls) names.push_back(w.name);
+  return names;
+}
+
+void readExperiment(TableReader& root, const sim::Model& model, ExperimentSettings& e) {
+  auto t = root.table("experiment");
+  if (!t) return;
+  e.type = t->requiredString("type", {"drop", "heap", "chute"});
+  const Range positive = Range::positive();
+  e.check_interval = t->number("check_interval", e.check_interval, positive);
+  if (e.type == "heap" || e.type == "chute") {
+    e.settle_speed = t->number("settle_speed", e.settle_speed, positive);
+    e.settle_min_time = t->number("settle_min_time", e.settle_min_time, Range::nonNegative());
+    e.settle_max_time = t->number("settle_max_time", e.settle_max_time, positive);
+  }
+  if (e.type == "heap") {
+    e.base_z = t->number("base_z", e.base_z);
+    e.bin_width = t->number("bin_width", e.bin_width, positive);
+  }
+  if (e.type == "chute") {
+    const auto names = wallNames(model);
+    auto wallKey = [&](const std::string& key, const std::string& fallback) {
+      return t->string(key, fallback, names);
+    };
+    e.length = t->number("length", e.length, positive);
+    e.inclination_deg = t->number("inclination_deg", e.inclination_deg, Range::closed(0, 90));
+    e.deposit_inclination_deg = t->number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
+    e.rotate_gravity = t->string("gravity_tilt", "rotate", {"rotate", "add"}) == "rotate";
+    if (!e.rotate_gravity && (e.inclination_deg >= 90 || e.deposit_inclination_deg >= 90))
+      t->fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
+    e.gate_wall = wallKey("gate_wall", e.gate_wall);
+    if (t->has("top_wall")) e.top_wall = wallKey("top_wall", "");
+    e.temporary_walls = t->stringList("temporary_walls", names);
+    e.tilt_steps = static_cast<std::uint64_t>(t->integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
+    e.marker_columns = t->numberList("marker_columns", Range::nonNegative());
+    e.marker_heights = t->numberList("marker_heights", Range::nonNegative());
+    e.marker_y = t->number("marker_y", e.marker_y, Range::nonNegative());
+    e.measure_distance = t->number("measure_distance", e.measure_distance, positive);
+    e.remove_beyond = t->number("remove_beyond", e.remove_beyond, positive);
+    e.jam_time = t->number("jam_time", e.jam_time, positive);
+  }
+  t->finish();
 }
 
 Scene readScene(const toml::table& root_table, const std::filesystem::path& base_dir,
@@ -296,7 +459,9 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   }
 
   readWalls(root, materials, base_dir, model);
-  readParticles(root, materials, scene.run.seed, scene.spheres);
+  readParticles(root, materials, model.materials, scene.run.seed, base_dir, scene);
+
+  readExperiment(root, model, scene.experiment);
 
   // [output]
   if (auto t = root.table("output")) {

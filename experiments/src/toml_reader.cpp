@@ -193,6 +193,24 @@ std::vector<double> TableReader::numberList(const std::string& key, Range range)
   return out;
 }
 
+std::vector<std::string> TableReader::stringList(const std::string& key, const std::vector<std::string>& allowed) {
+  const toml::node* n = node(key);
+  std::vector<std::string> out;
+  if (!n) return out;
+  std::string options;
+  for (const auto& a : allowed) options += (options.empty() ? "" : ", ") + ("\"" + a + "\"");
+  auto a = n->as_array();
+  if (!a) fail(key, "expected an array of strings" + (allowed.empty() ? "" : "; allowed: " + options));
+  for (const toml::node& e : *a) {
+    auto v = e.as_string();
+    if (!v) fail(key, "expected an array of strings");
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), v->get()) == allowed.end())
+      fail(key, "\"" + v->get() + "\" is not allowed; allowed: " + options);
+    out.push_back(v->get());
+  }
+  return out;
+}
+
 std::optional<TableReader> TableReader::table(const std::string& key) {
   const toml::node* n = node(key);
   if (!n) return std::nullopt;

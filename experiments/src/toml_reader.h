@@ -50,6 +50,7 @@ class TableReader {
   geometry::Vec3 requiredVec3(const std::string& key);
   std::vector<geometry::Vec3> vec3List(const std::string& key);
   std::vector<double> numberList(const std::string& key, Range range = {});
+  std::vector<std::string> stringList(const std::string& key, const std::vector<std::string>& allowed = {});
   std::optional<TableReader> table(const std::string& key);
   std::vector<TableReader> tableArray(const std::string& key);
   /// Names of all keys of this table (for tables of named entries).

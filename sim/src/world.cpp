@@ -307,6 +307,8 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
     w.pair_shear[it - w.pairs.partner.begin()] = h.shear;
   }
   for (const WallHistory& h : state.wall_history) {
+    if (h.wall >= w.walls.size()) throw std::invalid_argument("checkpoint: wall contact history for a missing wall");
+    if (!w.walls[h.wall].active) continue;  // the wall was removed: its contacts went with it
     bool found = false;
     for (std::uint32_t c = w.wall_offset[h.particle]; c < w.wall_offset[h.particle + 1]; ++c)
       if (w.wall_index[c] == h.wall) {

@@ -1,0 +1,370 @@
+// Inclined chute and zoned chute (experiments.md §c, §d). Phases:
+//   deposit  gravity tilted by deposit_inclination_deg (0 = vertical), gate
+//            closed, until no ball is faster than settle_speed;
+//            then temporary walls go, the top plate comes (bodies it cuts are
+//            deleted) and the tracers are chosen: the bodies nearest the lab's
+//            marker positions (5 columns x 4 against the camera wall, §c DEM 2);
+//   tilt     gravity at the test inclination, gate still closed, tilt_steps
+//            steps (the study's 5000 cycles of settling after the tilt, §c DEM 3);
+//   flow     gate removed; every check_interval (500 fps like the lab camera)
+//            the markers' travel along the base is sampled, and bodies past the
+//            outlet are counted as discharged; bodies remove_beyond past the
+//            outlet are deleted. Ends when every body is out (clearance) or
+//            when none left for jam_time (jammed).
+// Chute frame: outlet at x = 0, feed end at x = length, base z = 0, camera wall
+// y = 0; the tilt turns gravity instead of the geometry (§c DEM 4).
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <ostream>
+#include <sstream>
+#include <unordered_set>
+
+#include "experiment.h"
+#include "plot.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+using geometry::Vec3;
+
+struct Marker {
+  std::uint64_t id = 0;
+  int column = 0;       // 1 = nearest the outlet
+  int row = 0;          // 1 = lowest
+  Vec3 target = Vec3::Zero();  // m, the lab position it stands for
+  Vec3 start = Vec3::Zero();   // m, position when the gate opened
+  double last_travel = 0.0, last_time = 0.0;
+  double travel_time = std::numeric_limits<double>::quiet_NaN();  // s from gate opening to measure_distance
+  double velocity = std::numeric_limits<double>::quiet_NaN();     // m/s, measure_distance / travel_time
+};
+
+nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+class ChuteExperiment final : public Experiment {
+ public:
+  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {}
+
+  bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
+    if (phase_ == Phase::Start) {
+      every_ = static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
+      switchPhase(world, ctx, [&](sim::Model& m) {
+        m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
+        m.gravity_changes.clear();  // the experiment owns gravity
+        if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = std::numeric_limits<double>::infinity();
+      });
+      phase_ = Phase::Deposit;
+      bodies_total_ = indexBodies(world->particles()).size();
+    }
+    const std::uint64_t step = world->stepCount();
+    if (phase_ == Phase::Tilt) {
+      if (step < tilt_end_step_) return true;
+      openGate(world, ctx);
+      return true;
+    }
+    if (step % every_ != 0) return true;
+    const double t = world->time();
+    if (phase_ == Phase::Deposit) {
+      speed_ = maxBallSpeed(world->particles());
+      if (t < e_.settle_min_time) return true;
+      settled_ = speed_ < e_.settle_speed;
+      if (!settled_ && t < e_.settle_max_time) return true;
+      endDeposit(world, ctx);
+      return true;
+    }
+    return sampleFlow(world, ctx);
+  }
+
+  std::string progress() const override {
+    std::ostringstream s;
+    s << std::setprecision(3);
+    switch (phase_) {
+      case Phase::Start:
+      case Phase::Deposit: s << "deposit, max speed " << speed_ << " m/s"; break;
+      case Phase::Tilt: s << "tilt"; break;
+      case Phase::Flow: s << "flow, " << (bodies_total_ - discharged_count_) << " bodies in the chute"; break;
+      case Phase::Done: s << "done"; break;
+    }
+    return s.str();
+  }
+
+  void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override;
+
+ private:
+  enum class Phase { Start, Deposit, Tilt, Flow, Done };
+
+  void endDeposit(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    const double t = world->time();
+    deposit_time_ = t;
+    const sim::ParticleState& p = world->particles();
+    // Bodies cut by (or beyond) the top plate go: the plate is placed into the
+    // deposited bed, as in the study's zoned chute (§d DEM 3).
+    std::vector<bool> remove;
+    if (!e_.top_wall.empty()) {
+      const sim::Wall& top = world->model().walls[wallIndex(world->model(), e_.top_wall)];
+      Vec3 normal = top.normal, point = top.point;
+      if (top.shape == sim::WallShape::Polygon) {
+        normal = (top.vertices[1] - top.vertices[0]).cross(top.vertices[2] - top.vertices[0]).normalized();
+        point = top.vertices[0];
+        if (normal.z() > 0) normal = -normal;  // faces down, into the channel
+      }
+      remove.assign(p.size(), false);
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (normal.dot(p.position[i] - point) < p.radius[i]) {
+          remove[i] = true;
+          ++removed_by_top_;
+        }
+    }
+    // Bed height: 95th percentile of the ball tops (robust to a few loose balls).
+    std::vector<double> tops;
+    for (std::size_t i = 0; i < p.size(); ++i) tops.push_back(p.position[i].z() + p.radius[i]);
+    if (!tops.empty()) {
+      std::sort(tops.begin(), tops.end());
+      bed_height_ = tops[static_cast<std::size_t>(0.95 * static_cast<double>(tops.size() - 1))];
+    }
+    switchPhase(
+        world, ctx,
+        [&](sim::Model& m) {
+          for (const std::string& name : e_.temporary_walls) m.walls[wallIndex(m, name)].active_until = t;
+          if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = t;
+          m.gravity = tiltedGravity(g_, e_.inclination_deg, e_.rotate_gravity);
+        },
+        remove);
+    bodies_ = indexBodies(world->particles());
+    bodies_total_ = bodies_.size();
+    chooseMarkers(world->particles());
+    tilt_end_step_ = world->stepCount() + e_.tilt_steps;
+    phase_ = Phase::Tilt;
+  }
+
+  /// The bodies nearest the lab marker positions, each taken once (column 1 first, bottom up).
+  void chooseMarkers(const sim::ParticleState& p) {
+    double y = e_.marker_y;
+    if (y <= 0) {  // one radius from the camera wall: the median ball radius
+      std::vector<double> r(p.radius);
+      std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+      y = r.empty() ? 0.0 : r[r.size() / 2];
+    }
+    std::vector<std::uint64_t> taken;
+    for (std::size_t c = 0; c < e_.marker_columns.size(); ++c)
+      for (std::size_t h = 0; h < e_.marker_heights.size(); ++h) {
+        Marker m;
+        m.column = static_cast<int>(c) + 1;
+        m.row = static_cast<int>(h) + 1;
+        m.target = Vec3(e_.marker_columns[c], y, e_.marker_heights[h]);
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& [id, ref] : bodies_) {
+          const double d = (bodyPosition(p, ref) - m.target).squaredNorm();
+          if (d < best && std::find(taken.begin(), taken.end(), id) == taken.end()) {
+            best = d;
+            m.id = id;
+          }
+        }
+        if (!std::isfinite(best)) continue;  // fewer bodies than markers
+        taken.push_back(m.id);
+        markers_.push_back(m);
+      }
+  }
+
+  void openGate(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    const double t = world->time();
+    switchPhase(world, ctx, [&](sim::Model& m) { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; });
+    gate_time_ = last_discharge_ = t;
+    bodies_ = indexBodies(world->particles());
+    for (Marker& m : markers_) m.start = bodyPosition(world->particles(), bodies_.at(m.id));
+    phase_ = Phase::Flow;
+  }
+
+  bool sampleFlow(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    const double t = world->time();
+    const sim::ParticleState& p = world->particles();
+    // Markers: travel along the base towards the outlet (-x), interpolated to
+    // the moment it reaches measure_distance.
+    for (Marker& m : markers_) {
+      if (std::isfinite(m.velocity)) continue;
+      const auto it = bodies_.find(m.id);
+      if (it == bodies_.end()) continue;
+      const double travel = m.start.x() - bodyPosition(p, it->second).x();
+      if (travel >= e_.measure_distance) {
+        const double f = (e_.measure_distance - m.last_travel) / std::max(travel - m.last_travel, 1e-300);
+        m.travel_time = (m.last_time + f * (t - gate_time_ - m.last_time));
+        m.velocity = e_.measure_distance / m.travel_time;
+      }
+      m.last_travel = travel;
+      m.last_time = t - gate_time_;
+    }
+    // Discharge: a body is out once its centre passed the outlet.
+    bool far_out = false;
+    for (const auto& [id, ref] : bodies_) {
+      const double x = bodyPosition(p, ref).x();
+      if (x < 0 && discharged_.insert(id).second) {
+        ++discharged_count_;
+        discharged_mass_ += bodyMass(p, ref);
+        discharge_curve_.emplace_back(t - gate_time_, discharged_mass_);
+        last_discharge_ = t;
+      }
+      far_out = far_out || x < -e_.remove_beyond;
+    }
+    if (discharged_count_ == bodies_total_) {
+      clearance_time_ = last_discharge_ - gate_time_;
+      phase_ = Phase::Done;
+      return false;
+    }
+    if (t - last_discharge_ > e_.jam_time) {
+      jammed_ = true;
+      phase_ = Phase::Done;
+      return false;
+    }
+    // Delete bodies well past the outlet (every 10 checks): they only fall.
+    if (far_out && ++checks_since_removal_ >= 10) {
+      checks_since_removal_ = 0;
+      std::vector<bool> remove(p.size(), false);
+      for (std::size_t i = 0; i < p.size(); ++i) remove[i] = p.position[i].x() < -e_.remove_beyond;
+      // withoutBalls removes whole clumps; keep a clump with any member still near the outlet.
+      for (std::size_t c = 0; c < p.clumps.size(); ++c) {
+        bool all = true;
+        for (std::uint32_t k = p.clumps.member_begin[c]; k < p.clumps.member_begin[c + 1]; ++k)
+          all = all && remove[p.clumps.member_ball[k]];
+        if (!all)
+          for (std::uint32_t k = p.clumps.member_begin[c]; k < p.clumps.member_begin[c + 1]; ++k)
+            remove[p.clumps.member_ball[k]] = false;
+      }
+      switchPhase(world, ctx, [](sim::Model&) {}, remove);
+      bodies_ = indexBodies(world->particles());
+    }
+    return true;
+  }
+
+  ExperimentSettings e_;
+  double g_;
+  Phase phase_ = Phase::Start;
+  std::uint64_t every_ = 1, tilt_end_step_ = 0;
+  std::unordered_map<std::uint64_t, BodyRef> bodies_;
+  std::size_t bodies_total_ = 0, removed_by_top_ = 0;
+  bool settled_ = false, jammed_ = false;
+  double speed_ = 0, deposit_time_ = std::numeric_limits<double>::quiet_NaN();
+  double gate_time_ = std::numeric_limits<double>::quiet_NaN(), last_discharge_ = 0;
+  double clearance_time_ = std::numeric_limits<double>::quiet_NaN(), bed_height_ = 0;
+  std::vector<Marker> markers_;
+  std::unordered_set<std::uint64_t> discharged_;
+  std::size_t discharged_count_ = 0;
+  double discharged_mass_ = 0;
+  std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
+  int checks_since_removal_ = 0;
+};
+
+void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) {
+  const bool flowed = std::isfinite(gate_time_);
+  r["clearance_time_s"] = orNull(clearance_time_);
+  r["jammed"] = jammed_;
+  nlohmann::json markers = nlohmann::json::array();
+  for (const Marker& m : markers_)
+    markers.push_back({{"id", m.id},
+                       {"column", m.column},
+                       {"row", m.row},
+                       {"lab_position_m", {m.target.x(), m.target.y(), m.target.z()}},
+                       {"start_position_m", {m.start.x(), m.start.y(), m.start.z()}},
+                       {"travel_time_s", orNull(m.travel_time)},
+                       {"truth_velocity_mps", orNull(m.velocity)}});
+  r["markers"] = markers;
+  nlohmann::json profile = nlohmann::json::array();
+  for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
+    double sum = 0;
+    int n = 0;
+    for (const Marker& m : markers_)
+      if (m.column == static_cast<int>(c) + 1 && std::isfinite(m.velocity)) {
+        sum += m.velocity;
+        ++n;
+      }
+    profile.push_back({{"column", c + 1},
+                       {"distance_m", e_.marker_columns[c]},
+                       {"mean_truth_velocity_mps", n ? nlohmann::json(sum / n) : nlohmann::json(nullptr)},
+                       {"markers_measured", n}});
+  }
+  r["profile"] = profile;
+  r["chute"] = {{"inclination_deg", e_.inclination_deg},
+                {"gravity_tilt", e_.rotate_gravity ? "rotate" : "add"},
+                {"deposit_inclination_deg", e_.deposit_inclination_deg},
+                {"deposit_settled", settled_},
+                {"deposit_end_s", orNull(deposit_time_)},
+                {"deposit_max_speed_mps", speed_},
+                {"bed_height_m", bed_height_},
+                {"bodies_removed_by_top_plate", removed_by_top_},
+                {"bodies", bodies_total_},
+                {"gate_open_s", orNull(gate_time_)},
+                {"discharged_bodies", discharged_count_},
+                {"discharged_mass_kg", discharged_mass_},
+                {"measure_distance_m", e_.measure_distance},
+                {"tilt_steps", e_.tilt_steps}};
+
+  // CSV tables with units in the header, and the two plots.
+  {
+    std::ofstream csv(out_dir / "markers.csv");
+    csv << "id,column,row,start_x_m,start_y_m,start_z_m,travel_time_s,truth_velocity_mps\n";
+    for (const Marker& m : markers_)
+      csv << m.id << ',' << m.column << ',' << m.row << ',' << m.start.x() << ',' << m.start.y() << ','
+          << m.start.z() << ',' << m.travel_time << ',' << m.velocity << '\n';
+    std::ofstream d(out_dir / "discharge.csv");
+    d << "time_after_gate_s,discharged_mass_kg\n";
+    for (const auto& [t, m] : discharge_curve_) d << t << ',' << m << '\n';
+  }
+  if (flowed) {
+    PlotSpec prof;
+    prof.title = "marker velocity over the first " + std::to_string(static_cast<int>(std::lround(e_.measure_distance * 1e3))) +
+                 " mm (DEM truth), " + std::to_string(static_cast<int>(std::lround(e_.inclination_deg))) + " deg";
+    prof.x_label = "velocity along the base (m/s)";
+    prof.y_label = "initial height above the base (mm)";
+    for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
+      PlotSeries s;
+      s.label = "column " + std::to_string(c + 1) + " (" + std::to_string(static_cast<int>(std::lround(e_.marker_columns[c] * 1e3))) + " mm)";
+      std::vector<std::pair<double, double>> points;  // (height mm, velocity), drawn bottom up
+      for (const Marker& m : markers_)
+        if (m.column == static_cast<int>(c) + 1) points.emplace_back(m.start.z() * 1e3, m.velocity);
+      std::sort(points.begin(), points.end());
+      for (const auto& [z, v] : points) {
+        s.x.push_back(v);
+        s.y.push_back(z);
+      }
+      prof.series.push_back(s);
+    }
+    writePlot(prof, out_dir / "velocity_profile.png");
+    PlotSpec dis;
+    dis.title = "discharged mass after the gate opened";
+    dis.x_label = "time after gate opening (s)";
+    dis.y_label = "discharged mass (kg)";
+    PlotSeries s{"discharged", {0.0}, {0.0}, PlotSeries::Style::Line};
+    for (const auto& [t, m] : discharge_curve_) {
+      s.x.push_back(t);
+      s.y.push_back(m);
+    }
+    dis.series = {s};
+    writePlot(dis, out_dir / "discharge.png");
+  }
+
+  log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit "
+      << (settled_ ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed " << bed_height_ * 1e3
+      << " mm, " << bodies_total_ << " bodies";
+  if (removed_by_top_) log << " (" << removed_by_top_ << " balls cut by the top plate removed)";
+  log << "\n";
+  if (!flowed) {
+    log << "chute: the gate never opened (the run ended first: raise scene.end_time)\n";
+    return;
+  }
+  log << "chute: " << (jammed_ ? "JAMMED" : std::isfinite(clearance_time_) ? "cleared" : "still flowing at the end")
+      << ", clearance time " << (std::isfinite(clearance_time_) ? std::to_string(clearance_time_) + " s" : "-")
+      << ", discharged " << discharged_count_ << "/" << bodies_total_ << " bodies\n";
+  for (const auto& c : profile)
+    log << "  column " << c["column"] << " at " << c["distance_m"].get<double>() * 1e3 << " mm: mean marker velocity "
+        << c["mean_truth_velocity_mps"] << " m/s\n";
+}
+
+}  // namespace
+
+std::unique_ptr<Experiment> makeChuteExperiment(const Scene& scene) {
+  return std::make_unique<ChuteExperiment>(scene);
+}
+
+}  // namespace rocklab::experiments

@@ -1,0 +1,71 @@
+#pragma once
+// Experiment drivers: what a scene's [experiment] table asks for besides
+// stepping — phases (deposit, tilt, open the gate), measurements and the end
+// condition. The run loop (run.cpp) calls advance() between steps; a phase
+// switch rebuilds the World from its exported state with an edited Model
+// (gravity turned, a wall removed or added, bodies deleted), so the engine
+// keeps a constant Model and the contact history survives the switch.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "rocklab/experiments/scene.h"
+#include "rocklab/sim/world.h"
+
+namespace rocklab::experiments {
+
+struct ExperimentContext {
+  int threads = 0;
+  std::ostream* log = nullptr;
+};
+
+class Experiment {
+ public:
+  virtual ~Experiment() = default;
+  /// True when the coming step should hand its snapshot to observe().
+  virtual bool wantsSnapshot(std::uint64_t /*step*/) const { return false; }
+  virtual void observe(const sim::Snapshot& /*s*/) {}
+  /// Called before every step; may replace the world. False = the experiment is over.
+  virtual bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) = 0;
+  /// A few words for the progress line, e.g. "phase flow, 812 bodies left".
+  virtual std::string progress() const { return {}; }
+  /// Adds the figures to results.json and writes the experiment's CSV and PNG files.
+  virtual void report(nlohmann::json& results, const std::filesystem::path& out_dir, std::ostream& log) = 0;
+};
+
+/// The driver for scene.experiment.type, or null for a plain run.
+std::unique_ptr<Experiment> makeExperiment(const Scene& scene);
+
+// ---- helpers shared by the drivers
+
+/// One rigid body of a world: a free sphere (ball index) or a clump.
+struct BodyRef {
+  bool clump = false;
+  std::uint32_t index = 0;  // ball index for a sphere, clump index for a clump
+};
+
+/// Every body of a world by its stable id (sphere ids and clump ids share one space).
+std::unordered_map<std::uint64_t, BodyRef> indexBodies(const sim::ParticleState& p);
+/// Centre of mass, velocity (at t - dt/2) and mass of a body.
+geometry::Vec3 bodyPosition(const sim::ParticleState& p, const BodyRef& b);
+double bodyMass(const sim::ParticleState& p, const BodyRef& b);
+/// Largest ball speed (members included, so spin counts too), m/s.
+double maxBallSpeed(const sim::ParticleState& p);
+/// Gravity of magnitude g tilted by `angle_deg` towards -x (the chute outlet):
+/// rotated (|g| kept) or with the study's additional component g tan(angle).
+geometry::Vec3 tiltedGravity(double g, double angle_deg, bool rotate);
+/// Index of the wall called `name` (the scene reader checked that it exists).
+std::size_t wallIndex(const sim::Model& model, const std::string& name);
+
+/// Rebuilds `world` from its state after `edit` changed a copy of the model and
+/// `remove` (one flag per ball, may be empty) deleted bodies.
+void switchPhase(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx,
+                 const std::function<void(sim::Model&)>& edit, const std::vector<bool>& remove = {});
+
+}  // namespace rocklab::experiments

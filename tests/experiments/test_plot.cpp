@@ -1,0 +1,99 @@
+// PNG plots: drawn at the asked size with the series colours, written atomically,
+// errors name the file, degenerate data does not crash.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "plot.h"
+
+using namespace rocklab::experiments;
+using Catch::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+/// A fresh directory under the system temp directory.
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rocklab-plot-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+/// Pixels of exactly this BGR colour.
+int countColour(const cv::Mat& img, cv::Vec3b bgr) {
+  int n = 0;
+  for (int r = 0; r < img.rows; ++r)
+    for (int c = 0; c < img.cols; ++c) n += img.at<cv::Vec3b>(r, c) == bgr;
+  return n;
+}
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+}  // namespace
+
+TEST_CASE("a plot with two series and NaNs is drawn and written", "[plot]") {
+  const fs::path dir = tempDir("two");
+  PlotSpec spec;
+  spec.title = "angle of repose vs friction";
+  spec.x_label = "friction coefficient (-)";
+  spec.y_label = "angle of repose (deg)";
+  PlotSeries dem{"DEM", {}, {}, PlotSeries::Style::LinePoints};
+  for (int i = 0; i <= 10; ++i) {
+    dem.x.push_back(0.1 * i);
+    dem.y.push_back(i == 4 ? kNaN : 15.0 + 20.0 * std::sqrt(0.1 * i));  // a gap in the line
+  }
+  const PlotSeries lab{"lab mean", {0.0, 1.0, kNaN}, {26.03, 26.03, 3.0}, PlotSeries::Style::Line};
+  spec.series = {dem, lab};
+  const fs::path png = dir / "repose.png";
+  writePlot(spec, png);
+
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  REQUIRE(!img.empty());
+  CHECK(img.cols == 900);
+  CHECK(img.rows == 600);
+  const int non_white = img.rows * img.cols - countColour(img, {255, 255, 255});
+  CHECK(non_white > 5000);
+  CHECK(countColour(img, {178, 114, 0}) > 100);  // palette colour 0 (blue): points and line
+  CHECK(countColour(img, {0, 94, 213}) > 100);   // palette colour 1 (vermillion): line
+  CHECK(!fs::exists(dir / "repose.png.partial"));
+
+  // Writing again replaces the plot, and leaves no .partial either.
+  spec.width = 400;
+  spec.height = 300;
+  writePlot(spec, png);
+  CHECK(cv::imread(png.string()).cols == 400);
+  CHECK(!fs::exists(dir / "repose.png.partial"));
+}
+
+TEST_CASE("an unwritable plot path throws and names the file", "[plot]") {
+  PlotSpec spec;
+  spec.series = {{"s", {0, 1}, {0, 1}}};
+  const std::string path = "/proc/rocklab-no-such-dir/plot.png";
+  try {
+    writePlot(spec, path);
+    FAIL("no error");
+  } catch (const std::runtime_error& e) {
+    CHECK_THAT(e.what(), Contains(path));
+  }
+  PlotSeries bad{"uneven", {0, 1, 2}, {0, 1}};
+  spec.series = {bad};
+  CHECK_THROWS_WITH(writePlot(spec, tempDir("bad") / "p.png"), Contains("uneven") && Contains("3 x values"));
+}
+
+TEST_CASE("degenerate data: constant - single point - no finite data", "[plot]") {
+  const fs::path dir = tempDir("degenerate");
+  PlotSpec spec;
+  spec.series = {{"constant", {0, 1, 2, 3}, {2.5, 2.5, 2.5, 2.5}}};
+  CHECK_NOTHROW(writePlot(spec, dir / "constant.png"));
+  spec.series = {{"one point", {7.0}, {0.0}, PlotSeries::Style::Points}};
+  CHECK_NOTHROW(writePlot(spec, dir / "point.png"));
+  spec.series = {{"", {kNaN, 1.0}, {kNaN, kNaN}}, {}};
+  CHECK_NOTHROW(writePlot(spec, dir / "nothing.png"));
+  spec.series = {{"huge", {0, 1}, {-1e300, 1e300}}};
+  spec.y_range = std::pair{-1.0, 1.0};  // points far outside the fixed range are clipped
+  CHECK_NOTHROW(writePlot(spec, dir / "clipped.png"));
+  for (const char* name : {"constant.png", "point.png", "nothing.png", "clipped.png"})
+    CHECK(cv::imread((dir / name).string()).cols == 900);
+}
