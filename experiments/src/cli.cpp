@@ -7,6 +7,7 @@
 
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/sweep.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/world.h"
 
@@ -22,6 +23,10 @@ Examples:
   rocklab run my.toml --set timestep.safety_factor=0.3 --set output.vtk=true
   rocklab check my.toml                          # validate and print the time-step audit only
   rocklab restart runs/pour/checkpoint.h5 --set scene.end_time=2.0 --out runs/pour2
+  rocklab run drop                               # restitution of one pebble drop (results.json)
+  rocklab calibrate drop --vary contact.damping_normal=0:0.4 --target restitution=0.72
+  rocklab calibrate heap --vary materials.pebble.friction=0.2,0.3,0.4,0.5 --target angle_of_repose_deg=26.03
+  rocklab sweep chute-30-clumps --vary experiment.inclination_deg=27,30,33   # one table + plot
 
 Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
 watchdog, 130 interrupted by Ctrl-C (outputs so far are kept and readable).
@@ -84,6 +89,22 @@ int runCli(int argc, const char* const* argv) {
   check->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", overrides, "Override a scene key")->take_all();
   app.add_subcommand("list", "List the built-in scenes");
+  std::vector<std::string> vary, metrics;
+  std::string target;
+  int iterations = 8;
+  auto addSweepOptions = [&](CLI::App* c) {
+    c->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
+    c->add_option("--vary", vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
+    addRunOptions(c);
+  };
+  auto* sweep = app.add_subcommand("sweep", "Run a scene for every combination of --vary values; writes sweep.csv and sweep.png");
+  addSweepOptions(sweep);
+  sweep->add_option("--metric", metrics, "results.json figure to tabulate, dotted path (default: the experiment's)");
+  auto* calibrate = app.add_subcommand(
+      "calibrate", "Find the value of one key that gives a target figure (list: interpolate; lo:hi range: bisect)");
+  addSweepOptions(calibrate);
+  calibrate->add_option("--target", target, "metric=value, e.g. angle_of_repose_deg=26.03")->required();
+  calibrate->add_option("--iterations", iterations, "Bisection steps for a lo:hi range")->check(CLI::PositiveNumber);
 
   try {
     app.parse(argc, argv);
@@ -99,6 +120,33 @@ int runCli(int argc, const char* const* argv) {
   }
 
   if (app.got_subcommand("list")) return doList();
+  if (app.got_subcommand("sweep") || app.got_subcommand("calibrate")) {
+    SweepOptions so;
+    so.scene = scene_arg;
+    so.overrides = overrides;
+    so.metrics = metrics;
+    so.out_dir = out_dir;
+    so.threads = threads;
+    so.progress = !quiet;
+    std::signal(SIGINT, onSigint);
+    try {
+      for (const std::string& v : vary) so.vary.push_back(parseVary(v));
+      if (app.got_subcommand("sweep")) return runSweep(so, std::cerr);
+      CalibrateOptions co;
+      co.sweep = so;
+      co.iterations = iterations;
+      const auto eq = target.find('=');
+      if (eq == std::string::npos) throw std::invalid_argument("--target '" + target + "': expected metric=value");
+      co.target_metric = target.substr(0, eq);
+      std::size_t used = 0;
+      co.target = std::stod(target.substr(eq + 1), &used);
+      if (used != target.size() - eq - 1) throw std::invalid_argument("--target '" + target + "': value is not a number");
+      return runCalibrate(co, std::cerr);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
 
   Scene scene;
   RunOptions options;
@@ -125,9 +173,9 @@ int runCli(int argc, const char* const* argv) {
 
   if (app.got_subcommand("check")) {
     try {
-      sim::World world(scene.model, scene.spheres, 1);
+      sim::World world(scene.model, scene.spheres, scene.clumps, 1);
       std::cout << scene.source.string() << ": valid; " << scene.spheres.size() << " spheres, "
-                << scene.model.walls.size() << " walls\n"
+                << scene.clumps.size() << " clumps, " << scene.model.walls.size() << " walls\n"
                 << world.timestepAudit().describe(scene.model.timestep) << "\n";
       return kExitOk;
     } catch (const std::invalid_argument& e) {

@@ -480,16 +480,57 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
 
 }  // namespace
 
-Scene loadSceneText(const std::string& text, const std::string& source_name,
-                    const std::vector<std::string>& overrides, const std::filesystem::path& base_dir) {
-  toml::table table;
+namespace {
+
+toml::table parseToml(const std::string& text, const std::string& source_name) {
   try {
-    table = toml::parse(text, source_name);
+    return toml::parse(text, source_name);
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << source_name << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
     throw SceneError(s.str());
   }
+}
+
+/// Lays `over` onto `base`: tables merge key by key, anything else (numbers,
+/// strings, arrays, arrays of tables such as [[walls]]) replaces the base value.
+void mergeInto(toml::table& base, const toml::table& over) {
+  for (const auto& [key, value] : over) {
+    toml::table* base_table = base[key].as_table();
+    if (base_table && value.is_table())
+      mergeInto(*base_table, *value.as_table());
+    else
+      base.insert_or_assign(key, value);
+  }
+}
+
+/// A scene may start with `extends = "other.toml"` (path relative to the scene):
+/// it then holds only what differs from that scene, e.g. another inclination.
+void resolveExtends(toml::table& table, const std::string& source_name, const std::filesystem::path& base_dir,
+                    int depth) {
+  const toml::node* e = table.get("extends");
+  if (!e) return;
+  const auto name = e->value<std::string>();
+  if (!name) throw SceneError(source_name + ": extends: expected the file name of the scene to extend");
+  if (depth > 8) throw SceneError(source_name + ": extends: more than 8 levels (a cycle?)");
+  const std::filesystem::path file = base_dir / *name;
+  std::ifstream in(file);
+  if (!in) throw SceneError(source_name + ": extends = \"" + *name + "\": cannot open " + file.string());
+  std::stringstream buf;
+  buf << in.rdbuf();
+  toml::table base = parseToml(buf.str(), file.string());
+  resolveExtends(base, file.string(), file.parent_path(), depth + 1);
+  table.erase("extends");
+  mergeInto(base, table);
+  table = std::move(base);
+}
+
+}  // namespace
+
+Scene loadSceneText(const std::string& text, const std::string& source_name,
+                    const std::vector<std::string>& overrides, const std::filesystem::path& base_dir) {
+  toml::table table = parseToml(text, source_name);
+  resolveExtends(table, source_name, base_dir, 0);
   auto applied = std::make_shared<TableReader::Overrides>();
   for (const std::string& o : overrides) {
     detail::applyOverride(table, o);

@@ -1,0 +1,329 @@
+#include "rocklab/experiments/sweep.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "plot.h"
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+using json = nlohmann::json;
+
+/// The figures a sweep reports when none are named: the experiment's headline.
+std::vector<std::string> defaultMetrics(const Scene& scene) {
+  const std::string& type = scene.experiment.type;
+  std::vector<std::string> m;
+  if (type == "drop") m = {"restitution", "drop.contact_time_s"};
+  if (type == "heap") m = {"angle_of_repose_deg", "heap.settled"};
+  if (type == "chute") m = {"clearance_time_s", "jammed", "chute.bodies"};
+  m.push_back("simulated_time_s");
+  m.push_back("wall_time_s.total");
+  return m;
+}
+
+/// results.json value at a dotted path ("wall_time_s.total"); null when absent.
+json lookup(const json& r, const std::string& path) {
+  const json* node = &r;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', start);
+    const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (!node->is_object() || !node->contains(key)) return nullptr;
+    node = &(*node)[key];
+    if (dot == std::string::npos) return *node;
+    start = dot + 1;
+  }
+}
+
+std::string cell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_number()) {
+    std::ostringstream s;
+    s << std::setprecision(6) << v.get<double>();
+    return s.str();
+  }
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+struct Point {
+  std::vector<std::string> values;  // one per varied key
+  json results;
+  int code = kExitOk;
+};
+
+/// Loads the scene with the fixed and the varied assignments (throws SceneError).
+Scene sceneFor(const SweepOptions& o, const std::vector<std::string>& values) {
+  std::vector<std::string> overrides = o.overrides;
+  for (std::size_t k = 0; k < o.vary.size(); ++k) overrides.push_back(o.vary[k].first + "=" + values[k]);
+  return loadScene(resolveScene(o.scene), overrides);
+}
+
+/// Runs one point into dir (its log in dir/run.log); fills p.results.
+void runPoint(const SweepOptions& o, const std::filesystem::path& dir, Point& p, std::ostream& log) {
+  Scene scene = sceneFor(o, p.values);
+  std::filesystem::create_directories(dir);
+  RunOptions ro;
+  ro.out_dir = dir;
+  ro.threads = o.threads;
+  ro.progress = o.progress;
+  std::ofstream run_log(dir / "run.log");
+  p.code = runScene(scene, ro, run_log);
+  std::ifstream in(dir / "results.json");
+  if (in) p.results = json::parse(in, nullptr, false);
+  log << "  ";
+  for (std::size_t k = 0; k < o.vary.size(); ++k) log << o.vary[k].first << " = " << p.values[k] << "  ";
+  log << "-> " << (p.code == kExitOk ? "done" : "exit " + std::to_string(p.code)) << " (" << dir.string() << ")\n";
+}
+
+std::filesystem::path outDirFor(const SweepOptions& o, const Scene& scene, const std::string& suffix) {
+  return o.out_dir.empty() ? std::filesystem::path("out") / (scene.run.name + suffix) : o.out_dir;
+}
+
+/// Writes the table (CSV with the metric paths as headers) and prints it aligned.
+void writeTable(const SweepOptions& o, const std::vector<std::string>& metrics, const std::vector<Point>& points,
+                const std::filesystem::path& csv_path, std::ostream& log) {
+  std::vector<std::string> header;
+  for (const auto& [key, values] : o.vary) header.push_back(key);
+  for (const auto& m : metrics) header.push_back(m);
+  header.push_back("status");
+  std::vector<std::vector<std::string>> rows;
+  for (const Point& p : points) {
+    std::vector<std::string> row = p.values;
+    for (const auto& m : metrics) row.push_back(cell(lookup(p.results, m)));
+    row.push_back(p.code == kExitOk ? "ok" : "exit " + std::to_string(p.code));
+    rows.push_back(row);
+  }
+  std::ofstream csv(csv_path.string() + ".partial");
+  for (std::size_t c = 0; c < header.size(); ++c) csv << (c ? "," : "") << header[c];
+  csv << "\n";
+  for (const auto& row : rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << row[c];
+    csv << "\n";
+  }
+  csv.close();
+  std::filesystem::rename(csv_path.string() + ".partial", csv_path);
+  std::vector<std::size_t> width(header.size());
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    width[c] = header[c].size();
+    for (const auto& row : rows) width[c] = std::max(width[c], row[c].size());
+  }
+  auto print = [&](const std::vector<std::string>& row) {
+    for (std::size_t c = 0; c < row.size(); ++c) log << (c ? "  " : "  ") << std::setw(static_cast<int>(width[c])) << row[c];
+    log << "\n";
+  };
+  print(header);
+  for (const auto& row : rows) print(row);
+}
+
+double number(const json& v) {
+  if (v.is_number()) return v.get<double>();
+  if (v.is_boolean()) return v.get<bool>() ? 1.0 : 0.0;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+double toDouble(const std::string& text, const std::string& what) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
+    return v;
+  } catch (const std::exception&) {
+    throw std::invalid_argument(what + ": '" + text + "' is not a number");
+  }
+}
+
+}  // namespace
+
+std::pair<std::string, std::vector<std::string>> parseVary(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
+    throw std::invalid_argument("--vary '" + assignment + "': expected key=a,b,c (or key=lo:hi for calibrate)");
+  std::vector<std::string> values;
+  std::stringstream rest(assignment.substr(eq + 1));
+  std::string v;
+  while (std::getline(rest, v, ','))
+    if (!v.empty()) values.push_back(v);
+  if (values.empty()) throw std::invalid_argument("--vary '" + assignment + "': no values");
+  return {assignment.substr(0, eq), values};
+}
+
+int runSweep(const SweepOptions& o, std::ostream& log) {
+  if (o.vary.empty()) {
+    log << "error: sweep: give at least one --vary key=a,b,c\n";
+    return kExitBadInput;
+  }
+  // Every combination, the first key slowest; each scene is loaded (validated)
+  // before anything runs, so a bad value costs nothing.
+  std::vector<Point> points(1);
+  for (const auto& [key, values] : o.vary) {
+    std::vector<Point> next;
+    for (const Point& p : points)
+      for (const std::string& v : values) {
+        Point q = p;
+        q.values.push_back(v);
+        next.push_back(q);
+      }
+    points = next;
+  }
+  Scene first;
+  try {
+    for (const Point& p : points) first = sceneFor(o, p.values);
+    first = sceneFor(o, points.front().values);
+  } catch (const SceneError& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const std::vector<std::string> metrics = o.metrics.empty() ? defaultMetrics(first) : o.metrics;
+  const std::filesystem::path dir = outDirFor(o, first, "-sweep");
+  std::filesystem::create_directories(dir);
+  log << "sweep of " << first.run.name << ": " << points.size() << " runs into " << dir.string() << "\n";
+  int code = kExitOk;
+  std::vector<Point> done;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    std::ostringstream name;
+    name << "run-" << std::setw(3) << std::setfill('0') << k;
+    runPoint(o, dir / name.str(), points[k], log);
+    done.push_back(points[k]);
+    if (points[k].code == kExitInterrupted) {
+      code = kExitInterrupted;
+      break;
+    }
+  }
+  writeTable(o, metrics, done, dir / "sweep.csv", log);
+  // Plot: the first metric against the first key; one series per value of the second key.
+  PlotSpec spec;
+  spec.title = first.run.name + ": " + metrics.front() + " against " + o.vary.front().first;
+  spec.x_label = o.vary.front().first;
+  spec.y_label = metrics.front();
+  const std::size_t groups = o.vary.size() > 1 ? o.vary[1].second.size() : 1;
+  for (std::size_t g = 0; g < groups; ++g) {
+    PlotSeries s;
+    if (o.vary.size() > 1) s.label = o.vary[1].first + " = " + o.vary[1].second[g];
+    for (const Point& p : done) {
+      if (o.vary.size() > 1 && p.values[1] != o.vary[1].second[g]) continue;
+      try {
+        s.x.push_back(toDouble(p.values[0], o.vary.front().first));
+      } catch (const std::invalid_argument&) {
+        s.x.push_back(static_cast<double>(s.x.size()));  // a non-numeric key is plotted by position
+      }
+      s.y.push_back(number(lookup(p.results, metrics.front())));
+    }
+    spec.series.push_back(s);
+  }
+  try {
+    writePlot(spec, dir / "sweep.png");
+  } catch (const std::exception& e) {
+    log << "sweep: no plot (" << e.what() << ")\n";
+  }
+  log << "sweep: table " << (dir / "sweep.csv").string() << ", plot " << (dir / "sweep.png").string() << "\n";
+  return code;
+}
+
+int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
+  const SweepOptions& o = c.sweep;
+  if (o.vary.size() != 1) {
+    log << "error: calibrate: give exactly one --vary key=a,b,c or key=lo:hi\n";
+    return kExitBadInput;
+  }
+  const std::string& key = o.vary.front().first;
+  const auto& given = o.vary.front().second;
+  const bool range = given.size() == 1 && given.front().find(':') != std::string::npos;
+  std::vector<double> values;
+  try {
+    if (range) {
+      const std::string& r = given.front();
+      values = {toDouble(r.substr(0, r.find(':')), "--vary " + key), toDouble(r.substr(r.find(':') + 1), "--vary " + key)};
+    } else {
+      for (const auto& v : given) values.push_back(toDouble(v, "--vary " + key));
+    }
+  } catch (const std::invalid_argument& e) {
+    log << "error: calibrate: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  Scene first;
+  try {
+    for (double v : values) first = sceneFor(o, {cell(v)});
+  } catch (const SceneError& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const std::filesystem::path dir = outDirFor(o, first, "-calibrate");
+  std::filesystem::create_directories(dir);
+  log << "calibrate " << first.run.name << ": " << key << " for " << c.target_metric << " = " << c.target << "\n";
+  std::vector<Point> tried;
+  auto evaluate = [&](double v) -> double {
+    Point p;
+    p.values = {cell(v)};
+    std::ostringstream name;
+    name << "run-" << std::setw(3) << std::setfill('0') << tried.size();
+    runPoint(o, dir / name.str(), p, log);
+    tried.push_back(p);
+    if (p.code == kExitInterrupted) throw std::runtime_error("interrupted");
+    return number(lookup(p.results, c.target_metric)) - c.target;
+  };
+  std::vector<std::string> metrics{c.target_metric, "wall_time_s.total"};
+  double estimate = std::numeric_limits<double>::quiet_NaN();
+  std::string how;
+  try {
+    if (range) {
+      double lo = values[0], hi = values[1];
+      double f_lo = evaluate(lo), f_hi = evaluate(hi);
+      if (!(f_lo * f_hi <= 0)) {
+        how = "the target is not between the values at " + cell(lo) + " and " + cell(hi);
+      } else {
+        for (int k = 0; k < c.iterations; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          const double f_mid = evaluate(mid);
+          if (!std::isfinite(f_mid)) break;
+          if ((f_mid <= 0) == (f_lo <= 0)) {
+            lo = mid;
+            f_lo = f_mid;
+          } else {
+            hi = mid;
+            f_hi = f_mid;
+          }
+        }
+        estimate = f_hi == f_lo ? lo : lo - f_lo * (hi - lo) / (f_hi - f_lo);
+        how = "bisection, then linear interpolation in the last bracket [" + cell(lo) + ", " + cell(hi) + "]";
+      }
+    } else {
+      std::vector<double> f;
+      for (double v : values) f.push_back(evaluate(v));
+      for (std::size_t k = 0; k + 1 < values.size(); ++k)
+        if (std::isfinite(f[k]) && std::isfinite(f[k + 1]) && f[k] * f[k + 1] <= 0) {
+          estimate = f[k + 1] == f[k] ? values[k] : values[k] - f[k] * (values[k + 1] - values[k]) / (f[k + 1] - f[k]);
+          how = "linear interpolation between " + cell(values[k]) + " and " + cell(values[k + 1]);
+          break;
+        }
+      if (!std::isfinite(estimate)) how = "the target is not between any two neighbouring values";
+    }
+  } catch (const std::runtime_error&) {
+    writeTable(o, metrics, tried, dir / "calibration.csv", log);
+    return kExitInterrupted;
+  }
+  writeTable(o, metrics, tried, dir / "calibration.csv", log);
+  json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
+              {"target", c.target},      {"method", how},        {"runs", tried.size()},
+              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)}};
+  std::ofstream(dir / "calibration.json") << out.dump(2) << "\n";
+  if (!std::isfinite(estimate)) {
+    log << "calibrate: no estimate: " << how << "; widen the values\n";
+    return kExitOk;
+  }
+  log << "calibrate: " << key << " = " << cell(estimate) << " gives " << c.target_metric << " = " << c.target << " ("
+      << how << ")\n  check it: rocklab run " << o.scene << " --set " << key << "=" << cell(estimate) << "\n";
+  return kExitOk;
+}
+
+}  // namespace rocklab::experiments

@@ -1,0 +1,141 @@
+// The experiment drivers on small, soft versions of the real scenes: drop
+// restitution against Eq 4-4, the drop calibration, a heap with a non-zero
+// angle, a chute that discharges and one that jams. The full scenes are the
+// `validation` runs (README).
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/sweep.h"
+#include "rocklab/sim/timestep.h"
+
+namespace fs = std::filesystem;
+using namespace rocklab::experiments;
+using json = nlohmann::json;
+
+namespace {
+
+const std::string kAssets = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/";
+
+/// Softer contacts for CI (the rigid limit is the same; kn = 1e9 costs 30x the steps).
+std::vector<std::string> soft(const std::vector<std::string>& materials, double k) {
+  std::vector<std::string> o;
+  for (const auto& m : materials) {
+    o.push_back("materials." + m + ".kn=" + std::to_string(k));
+    o.push_back("materials." + m + ".ks=" + std::to_string(k));
+  }
+  return o;
+}
+
+json runFor(const std::string& scene_path, std::vector<std::string> overrides, const std::string& dir_name,
+            int expected_code = kExitOk) {
+  const fs::path dir = fs::temp_directory_path() / ("rocklab-exp-" + dir_name);
+  fs::remove_all(dir);
+  const Scene scene = loadScene(scene_path, overrides);
+  RunOptions options;
+  options.out_dir = dir;
+  options.threads = 2;
+  options.progress = false;
+  std::ostringstream log;
+  const int code = runScene(scene, options, log);
+  INFO(log.str());
+  REQUIRE(code == expected_code);
+  std::ifstream in(dir / "results.json");
+  return json::parse(in);
+}
+
+}  // namespace
+
+TEST_CASE("drop: measured restitution follows Eq 4-4 and converges with the step", "[experiment]") {
+  const double analytic = rocklab::sim::restitutionFromDamping(0.11);
+  const json coarse = runFor(kAssets + "drop.toml", {}, "drop-coarse");
+  const json fine = runFor(kAssets + "drop.toml", {"timestep.safety_factor=0.1"}, "drop-fine");
+  const double e_coarse = coarse["restitution"].get<double>(), e_fine = fine["restitution"].get<double>();
+  INFO("e at dt = 0.5 dt_crit: " << e_coarse << ", at 0.1 dt_crit: " << e_fine << ", Eq 4-4: " << analytic);
+  CHECK(std::abs(e_coarse - analytic) < 0.02);
+  CHECK(std::abs(e_fine - analytic) < 0.005);
+  CHECK(std::abs(e_fine - analytic) < std::abs(e_coarse - analytic));
+  // Contact with the plate: pi / omega_d for the ball mass and the series stiffness 5e8 N/m.
+  const double m = 2730.0 * 4.0 / 3.0 * M_PI * 1e-6;
+  const double tc = rocklab::sim::linearContactTime(m, 5e8, 0.11);
+  CHECK(fine["drop"]["contact_time_s"].get<double>() == Approx(tc).epsilon(0.05));
+}
+
+TEST_CASE("calibrate: finds the damping ratio for a target restitution", "[experiment]") {
+  CalibrateOptions c;
+  c.sweep.scene = kAssets + "drop.toml";
+  c.sweep.vary = {parseVary("contact.damping_normal=0.05,0.1,0.15")};
+  c.sweep.out_dir = fs::temp_directory_path() / "rocklab-exp-calibrate";
+  c.sweep.progress = false;
+  c.target_metric = "restitution";
+  c.target = 0.72;
+  fs::remove_all(c.sweep.out_dir);
+  std::ostringstream log;
+  REQUIRE(runCalibrate(c, log) == kExitOk);
+  INFO(log.str());
+  std::ifstream in(c.sweep.out_dir / "calibration.json");
+  const json r = json::parse(in);
+  // Eq 4-4 inverted gives 0.1036 for e = 0.72; the dt = 0.5 dt_crit drop loses a little more.
+  CHECK(r["estimate"].get<double>() == Approx(rocklab::sim::dampingFromRestitution(0.72)).margin(0.008));
+  CHECK(fs::exists(c.sweep.out_dir / "calibration.csv"));
+  CHECK(log.str().find("contact.damping_normal = 0.0") != std::string::npos);
+}
+
+TEST_CASE("heap: a small heap of clumps stands at a non-zero angle", "[experiment]") {
+  auto o = soft({"pebble", "table", "perspex"}, 1e6);
+  o.push_back("particles.0.count=250");
+  o.push_back("particles.0.region_max=[0.1, 0.1, 0.3]");
+  o.push_back("experiment.settle_min_time=1.0");
+  const json r = runFor(kAssets + "heap.toml", o, "heap");
+  INFO(r.dump(2));
+  REQUIRE(r["angle_of_repose_deg"].is_number());
+  const double angle = r["angle_of_repose_deg"].get<double>();
+  CHECK(angle > 10.0);
+  CHECK(angle < 40.0);
+  CHECK(r["heap"]["flank_angles_deg"].size() == 4);
+}
+
+TEST_CASE("chute: a short clump chute discharges and reports its markers", "[experiment]") {
+  auto o = soft({"pebble", "steel", "perspex"}, 1e6);
+  o.push_back("particles.0.count=300");
+  o.push_back("particles.0.region_max=[0.6, 0.3, 0.15]");
+  o.push_back("experiment.marker_heights=[0.01, 0.03]");
+  o.push_back("experiment.tilt_steps=500");
+  const fs::path dir = fs::temp_directory_path() / "rocklab-exp-chute";
+  const json r = runFor(kAssets + "chute-30-clumps.toml", o, "chute");
+  INFO(r.dump(2));
+  CHECK(r["jammed"] == false);
+  REQUIRE(r["clearance_time_s"].is_number());
+  CHECK(r["clearance_time_s"].get<double>() > 0.1);
+  CHECK(r["chute"]["discharged_bodies"] == 300);
+  REQUIRE(r["markers"].size() == 10);  // 5 columns x 2 heights
+  int measured = 0;
+  for (const auto& m : r["markers"]) {
+    if (!m["truth_velocity_mps"].is_number()) continue;
+    ++measured;
+    // A marker cannot average more than free sliding down a frictionless 30 deg
+    // slope over 100 mm (sqrt(2 g sin 30 x 0.1) / 2 = 0.5 m/s), nor stand still.
+    CHECK(m["truth_velocity_mps"].get<double>() > 0.02);
+    CHECK(m["truth_velocity_mps"].get<double>() < 0.6);
+  }
+  CHECK(measured >= 8);
+  REQUIRE(r["profile"].size() == 5);
+  CHECK(r["profile"][0]["distance_m"].get<double>() == Approx(0.1));
+  for (const char* f : {"velocity_profile.png", "discharge.png", "markers.csv", "discharge.csv"})
+    CHECK(fs::exists(dir / f));
+}
+
+TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[experiment]") {
+  auto o = soft({"pebble", "steel", "perspex"}, 1e6);
+  o.push_back("particles.0.count=200");
+  o.push_back("particles.0.region_max=[0.6, 0.3, 0.12]");
+  o.push_back("experiment.tilt_steps=200");
+  const json r = runFor(std::string(ROCKLAB_SOURCE_DIR) + "/tests/experiments/scenes/narrow-chute.toml", o, "jam");
+  CHECK(r["jammed"] == true);
+  CHECK(r["clearance_time_s"].is_null());
+  CHECK(r["chute"]["discharged_bodies"] == 0);
+}
