@@ -54,7 +54,7 @@ class ChuteExperiment final : public Experiment {
       switchPhase(world, ctx, [&](sim::Model& m) {
         m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
         m.gravity_changes.clear();  // the experiment owns gravity
-        if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = std::numeric_limits<double>::infinity();
+        if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = std::numeric_limits<double>::max();  // until placed
       });
       phase_ = Phase::Deposit;
       bodies_total_ = indexBodies(world->particles()).size();
@@ -109,14 +109,14 @@ class ChuteExperiment final : public Experiment {
       if (top.shape == sim::WallShape::Polygon) {
         normal = (top.vertices[1] - top.vertices[0]).cross(top.vertices[2] - top.vertices[0]).normalized();
         point = top.vertices[0];
-        if (normal.z() > 0) normal = -normal;  // faces down, into the channel
       }
+      if (normal.z() > 0) normal = -normal;  // faces down, into the channel
+      has_top_ = std::abs(normal.z()) > 1e-9;
+      top_point_ = point;
+      top_normal_ = normal;
       remove.assign(p.size(), false);
       for (std::size_t i = 0; i < p.size(); ++i)
-        if (normal.dot(p.position[i] - point) < p.radius[i]) {
-          remove[i] = true;
-          ++removed_by_top_;
-        }
+        remove[i] = normal.dot(p.position[i] - point) < p.radius[i];
     }
     // Bed height: 95th percentile of the ball tops (robust to a few loose balls).
     std::vector<double> tops;
@@ -134,6 +134,7 @@ class ChuteExperiment final : public Experiment {
         },
         remove);
     bodies_ = indexBodies(world->particles());
+    removed_by_top_ = bodies_total_ - bodies_.size();
     bodies_total_ = bodies_.size();
     chooseMarkers(world->particles());
     tilt_end_step_ = world->stepCount() + e_.tilt_steps;
@@ -149,12 +150,17 @@ class ChuteExperiment final : public Experiment {
       y = r.empty() ? 0.0 : r[r.size() / 2];
     }
     std::vector<std::uint64_t> taken;
-    for (std::size_t c = 0; c < e_.marker_columns.size(); ++c)
-      for (std::size_t h = 0; h < e_.marker_heights.size(); ++h) {
+    for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
+      // Heights in metres, or as fractions of the channel height at the column
+      // (the zoned chute's markers sit in the mid-layer of each zone, §d).
+      const double x = e_.marker_columns[c];
+      std::vector<double> heights = e_.marker_heights;
+      for (double f : e_.marker_height_fractions) heights.push_back(f * channelHeight(x));
+      for (std::size_t h = 0; h < heights.size(); ++h) {
         Marker m;
         m.column = static_cast<int>(c) + 1;
         m.row = static_cast<int>(h) + 1;
-        m.target = Vec3(e_.marker_columns[c], y, e_.marker_heights[h]);
+        m.target = Vec3(x, y, heights[h]);
         double best = std::numeric_limits<double>::infinity();
         for (const auto& [id, ref] : bodies_) {
           const double d = (bodyPosition(p, ref) - m.target).squaredNorm();
@@ -167,6 +173,14 @@ class ChuteExperiment final : public Experiment {
         taken.push_back(m.id);
         markers_.push_back(m);
       }
+    }
+  }
+
+  /// Height of the channel above the base at x: under the top plate, else the bed.
+  double channelHeight(double x) const {
+    if (!has_top_) return bed_height_;
+    // Plane through top_point_ with normal top_normal_: solve for z at (x, y = 0).
+    return top_point_.z() - (top_normal_.x() * (x - top_point_.x()) + top_normal_.y() * (0.0 - top_point_.y())) / top_normal_.z();
   }
 
   void openGate(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
@@ -254,6 +268,8 @@ class ChuteExperiment final : public Experiment {
   double discharged_mass_ = 0;
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
+  bool has_top_ = false;
+  Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
 };
 
 void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) {
@@ -347,7 +363,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit "
       << (settled_ ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed " << bed_height_ * 1e3
       << " mm, " << bodies_total_ << " bodies";
-  if (removed_by_top_) log << " (" << removed_by_top_ << " balls cut by the top plate removed)";
+  if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";
   if (!flowed) {
     log << "chute: the gate never opened (the run ended first: raise scene.end_time)\n";

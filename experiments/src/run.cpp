@@ -226,6 +226,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   const auto t_loop = Clock::now();
   const ExperimentContext context{options.threads, &log};
   bool experiment_over = false;
+  std::uint64_t ball_steps = 0;  // balls stepped, summed over steps (bodies may be removed)
   try {
     while (world->stepCount() < end_step) {
       if (g_stop) {
@@ -240,6 +241,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
       frame_due = k == first_step || k + 1 >= end_step || experiment_over || (frame_every && k % frame_every == 0);
       experiment_due = experiment && !experiment_over && experiment->wantsSnapshot(k);
       energy_due = energy_every && k % energy_every == 0;
+      ball_steps += world->particles().size();
       if (frame_due || experiment_due || energy_due)
         world->step(observer);
       else
@@ -252,6 +254,12 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     status = "stopped_by_watchdog";
     message = e.what();
     exit_code = kExitWatchdog;
+  } catch (const std::invalid_argument& e) {
+    // A phase switch of the experiment made an unusable world (e.g. a wall
+    // setting that only fails once the wall is placed): stop, keep the outputs.
+    status = "failed";
+    message = std::string("experiment phase switch: ") + e.what();
+    exit_code = kExitBadInput;
   }
   const auto t_loop_end = Clock::now();
   progress.finish();
@@ -305,7 +313,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
                       {"stepping", stepping},
                       {"output", output_seconds},
                       {"total", seconds(t_start, Clock::now())}};
-  r["particle_steps_per_s"] = stepping > 0 ? world->particles().size() * steps_done / stepping : 0.0;
+  r["particle_steps_per_s"] = stepping > 0 ? static_cast<double>(ball_steps) / stepping : 0.0;  // balls, members included
   r["neighbour_rebuilds"] = world->stats().neighbour_rebuilds;
   r["pairs_in_list"] = world->stats().pairs_in_list;
   r["neighbour_search_s"] = world->stats().neighbour_seconds;

@@ -59,7 +59,7 @@ void readMotion(TableReader& parent, sim::WallMotion& m) {
 void readWalls(TableReader& root, const std::map<std::string, int>& materials,
                const std::filesystem::path& base_dir, sim::Model& model) {
   for (TableReader t : root.tableArray("walls")) {
-    const std::string type = t.requiredString("type", {"plane", "polygon", "mesh", "box"});
+    const std::string type = t.requiredString("type", {"plane", "polygon", "plate", "mesh", "box"});
     const std::string name = t.string("name", t.path());
     sim::Wall w;
     w.name = name;
@@ -80,6 +80,18 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
       w.shape = sim::WallShape::Polygon;
       w.vertices = t.vec3List("vertices");
       if (w.vertices.size() < 3) t.fail("vertices", "a polygon needs at least 3 vertices [[x,y,z], ...]");
+      model.walls.push_back(w);
+    } else if (type == "plate") {
+      // A rectangle from `corner`: `length` along x turned up by angle_deg about
+      // y, `width` along y. The zoned chute's top plate: corner at the CSS above
+      // the outlet, angle = bite angle (experiments.md §d).
+      const Vec3 corner = t.requiredVec3("corner");
+      const double length = t.requiredNumber("length", Range::positive());
+      const double width = t.requiredNumber("width", Range::positive());
+      const double angle = t.number("angle_deg", 0.0, Range::closed(-90, 90)) * std::numbers::pi / 180.0;
+      const Vec3 along = length * Vec3(std::cos(angle), 0, std::sin(angle)), across(0, width, 0);
+      w.shape = sim::WallShape::Polygon;
+      w.vertices = {corner, corner + along, corner + along + across, corner + across};
       model.walls.push_back(w);
     } else if (type == "mesh") {
       w.shape = sim::WallShape::Mesh;
@@ -362,6 +374,9 @@ void readExperiment(TableReader& root, const sim::Model& model, ExperimentSettin
     e.tilt_steps = static_cast<std::uint64_t>(t->integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
     e.marker_columns = t->numberList("marker_columns", Range::nonNegative());
     e.marker_heights = t->numberList("marker_heights", Range::nonNegative());
+    e.marker_height_fractions = t->numberList("marker_height_fractions", Range::closed(0, 1));
+    if (!e.marker_heights.empty() && !e.marker_height_fractions.empty())
+      t->fail("marker_height_fractions", "give marker_heights (m) or marker_height_fractions, not both");
     e.marker_y = t->number("marker_y", e.marker_y, Range::nonNegative());
     e.measure_distance = t->number("measure_distance", e.measure_distance, positive);
     e.remove_beyond = t->number("remove_beyond", e.remove_beyond, positive);

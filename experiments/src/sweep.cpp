@@ -38,8 +38,19 @@ json lookup(const json& r, const std::string& path) {
   while (true) {
     const std::size_t dot = path.find('.', start);
     const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (!node->is_object() || !node->contains(key)) return nullptr;
-    node = &(*node)[key];
+    if (node->is_array()) {  // a numeric part indexes an array: clump_shapes.0.mass_kg
+      std::size_t used = 0, index = 0;
+      try {
+        index = std::stoul(key, &used);
+      } catch (const std::exception&) {
+        return nullptr;
+      }
+      if (used != key.size() || index >= node->size()) return nullptr;
+      node = &(*node)[index];
+    } else {
+      if (!node->is_object() || !node->contains(key)) return nullptr;
+      node = &(*node)[key];
+    }
     if (dot == std::string::npos) return *node;
     start = dot + 1;
   }
@@ -149,11 +160,20 @@ std::pair<std::string, std::vector<std::string>> parseVary(const std::string& as
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size())
     throw std::invalid_argument("--vary '" + assignment + "': expected key=a,b,c (or key=lo:hi for calibrate)");
+  // Commas inside brackets belong to a value: key=[0,0,0.03],[0,0,0.05].
   std::vector<std::string> values;
-  std::stringstream rest(assignment.substr(eq + 1));
   std::string v;
-  while (std::getline(rest, v, ','))
-    if (!v.empty()) values.push_back(v);
+  int depth = 0;
+  for (const char ch : assignment.substr(eq + 1)) {
+    depth += (ch == '[') - (ch == ']');
+    if (ch == ',' && depth == 0) {
+      if (!v.empty()) values.push_back(v);
+      v.clear();
+    } else {
+      v += ch;
+    }
+  }
+  if (!v.empty()) values.push_back(v);
   if (values.empty()) throw std::invalid_argument("--vary '" + assignment + "': no values");
   return {assignment.substr(0, eq), values};
 }

@@ -285,11 +285,19 @@ void applyOverride(toml::table& root, const std::string& assignment) {
       }
       cur = next;
     } else if (auto a = cur->as_array()) {
-      std::size_t idx = 0;
-      try {
-        idx = std::stoul(parts[k]);
-      } catch (...) {
-        throw SceneError("--set " + assignment + ": '" + parts[k] + "' must be an index into an array");
+      // An index, or the name of an entry (walls.gate.active_until = ...).
+      std::size_t idx = a->size();
+      for (std::size_t e = 0; e < a->size(); ++e)
+        if (const auto* entry = a->get(e)->as_table();
+            entry && entry->get("name") && entry->get("name")->value<std::string>() == parts[k])
+          idx = e;
+      if (idx == a->size()) {
+        try {
+          idx = std::stoul(parts[k]);
+        } catch (...) {
+          throw SceneError("--set " + assignment + ": '" + parts[k] +
+                           "' must be an index into the array or the name of one of its entries");
+        }
       }
       if (idx >= a->size())
         throw SceneError("--set " + assignment + ": index " + parts[k] + " is beyond the " +

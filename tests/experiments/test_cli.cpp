@@ -30,7 +30,7 @@ std::string slurp(const fs::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), {}};
 }
-const std::string kScene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/demo.toml";
+const std::string kScene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/hopper.toml";
 }  // namespace
 
 TEST_CASE("help and usage errors", "[cli]") {

@@ -139,3 +139,24 @@ TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[ex
   CHECK(r["clearance_time_s"].is_null());
   CHECK(r["chute"]["discharged_bodies"] == 0);
 }
+
+TEST_CASE("zoned chute: zones deposit - the top plate cuts - one marker per zone flows out", "[experiment]") {
+  std::vector<std::string> o = soft({"small", "medium", "large", "steel_base", "perspex"}, 1e6);
+  for (const char* s : {"particles.0.count=150", "particles.1.count=120", "particles.2.count=100",
+                        "particles.0.region_max=[0.2, 0.3, 0.3]", "particles.1.region_max=[0.4, 0.3, 0.35]",
+                        "particles.2.region_max=[0.6, 0.3, 0.4]", "experiment.tilt_steps=300"})
+    o.push_back(s);
+  const json r = runFor(kAssets + "zoned-chute.toml", o, "zoned");
+  INFO(r.dump(2));
+  CHECK(r["jammed"] == false);
+  CHECK(r["clearance_time_s"].is_number());
+  REQUIRE(r["markers"].size() == 3);
+  // Each marker sits in the mid-layer of its zone: half the channel height
+  // under the top plate (CSS 50 mm + x tan 20 deg), at most a clump away.
+  for (const auto& m : r["markers"]) {
+    const double x = m["lab_position_m"][0].get<double>(), z = m["lab_position_m"][2].get<double>();
+    CHECK(z == Approx(0.5 * (0.05 + x * std::tan(20.0 * M_PI / 180.0))).epsilon(1e-9));
+  }
+  CHECK(r["chute"]["deposit_inclination_deg"] == 45.0);
+  CHECK(r["clump_shapes"].size() == 3);
+}

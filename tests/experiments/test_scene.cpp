@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/sweep.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
@@ -133,4 +134,39 @@ triangles = [[0, 1, 2]]
   CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"missing.stl\"\n"),
              Contains("key 'walls.0.file' = \"missing.stl\": cannot read mesh"));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
+  const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/";
+  const Scene base = loadScene(dir + "chute-30-clumps.toml");
+  const Scene steep = loadScene(dir + "chute-33-clumps.toml");
+  CHECK(steep.experiment.inclination_deg == 33.0);
+  CHECK(steep.run.name == "chute-33-clumps");
+  CHECK(steep.clumps.size() == base.clumps.size());
+  CHECK(steep.model.walls.size() == base.model.walls.size());
+  CHECK(steep.experiment.marker_columns == base.experiment.marker_columns);
+  const Scene spheres = loadScene(dir + "chute-30-spheres.toml");  // [[particles]] replaced whole
+  CHECK(spheres.clumps.empty());
+  CHECK(spheres.spheres.size() == 1680);
+  CHECK_THROWS_WITH(loadSceneText("extends = \"nowhere.toml\"\n", "x.toml", {}, dir),
+                    Contains("x.toml: extends = \"nowhere.toml\": cannot open"));
+}
+
+TEST_CASE("--set addresses an array entry by its name", "[scene]") {
+  const std::string file = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/zoned-chute.toml";
+  const Scene s = loadScene(file, {"walls.top.angle_deg=30", "walls.top.corner=[0, 0, 0.04]"});
+  const auto& top = s.model.walls.back();
+  REQUIRE(top.name == "top");
+  CHECK(top.vertices[0].z() == Approx(0.04));
+  CHECK(top.vertices[1].z() == Approx(0.04 + 0.65 * 0.5));
+  CHECK_THROWS_WITH(loadScene(file, {"walls.nosuchwall.angle_deg=3"}),
+                    Contains("'nosuchwall' must be an index into the array or the name of one of its entries"));
+}
+
+TEST_CASE("--vary values keep commas inside brackets", "[scene]") {
+  const auto [key, values] = parseVary("walls.top.corner=[0,0,0.03],[0,0,0.05]");
+  CHECK(key == "walls.top.corner");
+  CHECK(values == std::vector<std::string>{"[0,0,0.03]", "[0,0,0.05]"});
+  CHECK(parseVary("a=1,2,3").second.size() == 3);
+  CHECK_THROWS(parseVary("novalues="));
 }

@@ -58,7 +58,8 @@ struct ExperimentSettings {
   std::string top_wall;                // wall added after deposition; bodies cut by it are removed
   std::uint64_t tilt_steps = 5000;     // steps at the test inclination with the gate closed
   std::vector<double> marker_columns;  // m from the outlet, column 1 first
-  std::vector<double> marker_heights;  // m above the base, the same in every column
+  std::vector<double> marker_heights;  // m above the base, the same in every column; or...
+  std::vector<double> marker_height_fractions;  // ...fractions of the local channel height (top plate, else bed)
   double marker_y = 0.0;               // m, distance of the marker centres from the camera wall; 0 = one radius
   double measure_distance = 0.1;       // m of travel over which a marker's mean velocity is taken
   double remove_beyond = 0.1;          // m past the outlet where discharged bodies are deleted
