@@ -152,7 +152,7 @@ TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
                     Contains("x.toml: extends = \"nowhere.toml\": cannot open"));
 }
 
-TEST_CASE("--set addresses an array entry by its name", "[scene]") {
+TEST_CASE("set overrides address an array entry by its name", "[scene]") {
   const std::string file = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/zoned-chute.toml";
   const Scene s = loadScene(file, {"walls.top.angle_deg=30", "walls.top.corner=[0, 0, 0.04]"});
   const auto& top = s.model.walls.back();
@@ -163,7 +163,7 @@ TEST_CASE("--set addresses an array entry by its name", "[scene]") {
                     Contains("'nosuchwall' must be an index into the array or the name of one of its entries"));
 }
 
-TEST_CASE("--vary values keep commas inside brackets", "[scene]") {
+TEST_CASE("vary values keep commas inside brackets", "[scene]") {
   const auto [key, values] = parseVary("walls.top.corner=[0,0,0.03],[0,0,0.05]");
   CHECK(key == "walls.top.corner");
   CHECK(values == std::vector<std::string>{"[0,0,0.03]", "[0,0,0.05]"});
