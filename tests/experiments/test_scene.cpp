@@ -170,3 +170,43 @@ TEST_CASE("vary values keep commas inside brackets", "[scene]") {
   CHECK(parseVary("a=1,2,3").second.size() == 3);
   CHECK_THROWS(parseVary("novalues="));
 }
+
+TEST_CASE("clump sources: four-ball by equivalent diameter and a clump file", "[scene]") {
+  const std::string text = R"(
+[scene]
+name = "clumps"
+end_time = 0.1
+[materials.rock]
+density = 2000.0
+[[particles]]
+type = "list"
+shape = "four_ball"
+equivalent_diameter = 0.02
+material = "rock"
+positions = [[0.0, 0.0, 0.1]]
+[[particles]]
+type = "random"
+shape = "file"
+file = "../clumps/three-ball.txt"
+mass_distribution = "equal_mass"
+material = "rock"
+count = 5
+region_min = [0.1, 0.1, 0.1]
+region_max = [0.2, 0.2, 0.2]
+)";
+  const Scene s = loadSceneText(text, "clumps.toml", {}, std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes");
+  REQUIRE(s.clumps.size() == 6);
+  REQUIRE(s.clump_shapes.size() == 2);
+  // Eq 4-2 sizing: the clump's mass is that of a 20 mm sphere of the density.
+  CHECK(s.clumps[0].mass == Approx(2000.0 * M_PI / 6.0 * 8e-6).epsilon(1e-9));
+  CHECK(s.clump_shapes[0].equivalent_diameter == Approx(0.02).epsilon(1e-9));
+  CHECK(s.clumps[1].members.size() == 3);
+  CHECK(s.clump_shapes[1].distribution == "equal_mass");
+  // Members are given about the centre of mass: their mean is the origin for equal masses.
+  rocklab::geometry::Vec3 mean = rocklab::geometry::Vec3::Zero();
+  for (const auto& m : s.clumps[1].members) mean += m.centre / 3.0;
+  CHECK(mean.norm() < 1e-12);
+  CHECK_THROWS_WITH(loadSceneText(text, "clumps.toml", {"particles.1.file=\"nope.txt\""},
+                                  std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes"),
+                    Contains("particles.1.file"));
+}
