@@ -251,21 +251,11 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
       points = geometry::latticePoints(lk, cell, offset, corner, n);
       radii.assign(points.size(), radius);
     } else if (type == "random") {
-      const auto count = t.integer("count", 0, Range::closed(1, 1e7));
-      if (!t.has("count")) t.fail("count", "missing; the number of particles to insert is required");
       const Vec3 lo = t.requiredVec3("region_min"), hi = t.requiredVec3("region_max");
+      double r_min = 0, r_max = 0, body_volume = 0;
       if (clumps) {
-        const std::vector<const std::vector<geometry::Sphere>*> shapes(static_cast<std::size_t>(count), &body.members);
-        const auto poses = geometry::randomNonOverlappingBodies(shapes, lo, hi, placed, rng);
-        if (poses.size() < shapes.size())
-          t.fail("count", "only " + std::to_string(poses.size()) + " of " + std::to_string(shapes.size()) +
-                              " clumps fit in the region without overlap; enlarge region_min/region_max or lower count");
-        for (const auto& pose : poses) {
-          points.push_back(pose.position);
-          orientations.push_back(pose.orientation);
-        }
+        body_volume = scene.clump_shapes.back().union_volume;
       } else {
-        double r_min, r_max;
         if (t.has("radius")) {
           r_min = r_max = t.number("radius", 0, Range::positive());
         } else {
@@ -274,11 +264,37 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
           if (r_max < r_min) t.fail("radius_max", "must be >= radius_min");
         }
         if (!((hi - lo).minCoeff() > 2 * r_max)) t.fail("region_max", "the region must be wider than a sphere");
+        // Mean volume of radii uniform in [r_min, r_max]: (4/3) pi <r^3>.
+        const double mean_r3 = r_max > r_min ? (std::pow(r_max, 4) - std::pow(r_min, 4)) / (4 * (r_max - r_min))
+                                             : std::pow(r_min, 3);
+        body_volume = 4.0 / 3.0 * std::numbers::pi * mean_r3;
+      }
+      if (t.has("count") == t.has("solid_fraction"))
+        t.fail("count", "give exactly one of count (particles) and solid_fraction (of the region volume, "
+                        "so that a size sweep fills the same space)");
+      std::int64_t count = t.integer("count", 0, Range::closed(1, 1e7));
+      if (t.has("solid_fraction")) {
+        const double f = t.number("solid_fraction", 0, {0.0, 0.6, true, false});
+        const double region = (hi - lo).cwiseMax(Vec3::Zero()).prod();
+        count = static_cast<std::int64_t>(std::floor(f * region / body_volume));
+        if (count < 1) t.fail("solid_fraction", "gives no particle in this region");
+      }
+      if (clumps) {
+        const std::vector<const std::vector<geometry::Sphere>*> shapes(static_cast<std::size_t>(count), &body.members);
+        const auto poses = geometry::randomNonOverlappingBodies(shapes, lo, hi, placed, rng);
+        if (poses.size() < shapes.size())
+          t.fail(t.has("count") ? "count" : "solid_fraction", "only " + std::to_string(poses.size()) + " of " + std::to_string(shapes.size()) +
+                              " clumps fit in the region without overlap; enlarge region_min/region_max or ask for fewer");
+        for (const auto& pose : poses) {
+          points.push_back(pose.position);
+          orientations.push_back(pose.orientation);
+        }
+      } else {
         for (std::int64_t k = 0; k < count; ++k) radii.push_back(rng.uniform(r_min, r_max));
         points = geometry::randomNonOverlapping(radii, lo, hi, placed, rng);
         if (points.size() < radii.size())
-          t.fail("count", "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
-                              " spheres fit in the region without overlap; enlarge region_min/region_max or lower count");
+          t.fail(t.has("count") ? "count" : "solid_fraction", "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
+                              " spheres fit in the region without overlap; enlarge region_min/region_max or ask for fewer");
       }
     } else {
       points = t.vec3List("positions");
