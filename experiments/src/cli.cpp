@@ -52,7 +52,8 @@ int doList() {
     } catch (const SceneError& e) {
       description = std::string("(invalid: ") + e.what() + ")";
     }
-    std::cout << "  " << f.stem().string() << std::string(std::max<std::size_t>(2, 16 - f.stem().string().size()), ' ')
+    const std::string name = f.stem().string();
+    std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ')
               << firstLine(description) << "\n";
   }
   return kExitOk;
