@@ -38,9 +38,13 @@ struct Marker {
   Vec3 target = Vec3::Zero();  // m, the lab position it stands for
   Vec3 start = Vec3::Zero();   // m, position when the gate opened
   double last_travel = 0.0, last_time = 0.0;
-  double travel_time = std::numeric_limits<double>::quiet_NaN();  // s from gate opening to measure_distance
-  double velocity = std::numeric_limits<double>::quiet_NaN();     // m/s, measure_distance / travel_time
+  double onset_time = std::numeric_limits<double>::quiet_NaN();   // s after gate opening: travel reached kOnset
+  double travel_time = std::numeric_limits<double>::quiet_NaN();  // s after gate opening: travel reached measure_distance
+  double velocity = std::numeric_limits<double>::quiet_NaN();     // m/s over the first measure_distance of its own motion
+  double velocity_from_gate = std::numeric_limits<double>::quiet_NaN();  // m/s, measure_distance / travel_time
 };
+
+constexpr double kOnset = 0.002;  // m of travel that marks the start of a marker's motion
 
 nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
@@ -195,20 +199,30 @@ class ChuteExperiment final : public Experiment {
   bool sampleFlow(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
     const sim::ParticleState& p = world->particles();
-    // Markers: travel along the base towards the outlet (-x), interpolated to
-    // the moment it reaches measure_distance.
+    // Markers: travel along the base towards the outlet (-x). The mean velocity
+    // over the first measure_distance of a marker's motion (§c step 5) runs from
+    // its onset (travel kOnset, so a marker upstream is not charged for the time
+    // the flow front took to reach it) to measure_distance; both moments are
+    // interpolated between samples. The velocity counted from the gate opening
+    // is kept too.
+    const double now = t - gate_time_;
+    auto crossing = [&](const Marker& m, double travel, double level) {
+      const double f = (level - m.last_travel) / std::max(travel - m.last_travel, 1e-300);
+      return m.last_time + f * (now - m.last_time);
+    };
     for (Marker& m : markers_) {
       if (std::isfinite(m.velocity)) continue;
       const auto it = bodies_.find(m.id);
       if (it == bodies_.end()) continue;
       const double travel = m.start.x() - bodyPosition(p, it->second).x();
+      if (!std::isfinite(m.onset_time) && travel >= kOnset) m.onset_time = crossing(m, travel, kOnset);
       if (travel >= e_.measure_distance) {
-        const double f = (e_.measure_distance - m.last_travel) / std::max(travel - m.last_travel, 1e-300);
-        m.travel_time = (m.last_time + f * (t - gate_time_ - m.last_time));
-        m.velocity = e_.measure_distance / m.travel_time;
+        m.travel_time = crossing(m, travel, e_.measure_distance);
+        m.velocity = (e_.measure_distance - kOnset) / (m.travel_time - m.onset_time);
+        m.velocity_from_gate = e_.measure_distance / m.travel_time;
       }
       m.last_travel = travel;
-      m.last_time = t - gate_time_;
+      m.last_time = now;
     }
     // Discharge: a body is out once its centre passed the outlet.
     bool far_out = false;
@@ -283,8 +297,10 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                        {"row", m.row},
                        {"lab_position_m", {m.target.x(), m.target.y(), m.target.z()}},
                        {"start_position_m", {m.start.x(), m.start.y(), m.start.z()}},
+                       {"onset_time_s", orNull(m.onset_time)},
                        {"travel_time_s", orNull(m.travel_time)},
-                       {"truth_velocity_mps", orNull(m.velocity)}});
+                       {"truth_velocity_mps", orNull(m.velocity)},
+                       {"velocity_from_gate_mps", orNull(m.velocity_from_gate)}});
   r["markers"] = markers;
   nlohmann::json profile = nlohmann::json::array();
   for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
@@ -314,15 +330,18 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"discharged_bodies", discharged_count_},
                 {"discharged_mass_kg", discharged_mass_},
                 {"measure_distance_m", e_.measure_distance},
+                {"marker_onset_m", kOnset},
                 {"tilt_steps", e_.tilt_steps}};
 
   // CSV tables with units in the header, and the two plots.
   {
     std::ofstream csv(out_dir / "markers.csv");
-    csv << "id,column,row,start_x_m,start_y_m,start_z_m,travel_time_s,truth_velocity_mps\n";
+    csv << "id,column,row,start_x_m,start_y_m,start_z_m,onset_time_s,travel_time_s,truth_velocity_mps,"
+           "velocity_from_gate_mps\n";
     for (const Marker& m : markers_)
       csv << m.id << ',' << m.column << ',' << m.row << ',' << m.start.x() << ',' << m.start.y() << ','
-          << m.start.z() << ',' << m.travel_time << ',' << m.velocity << '\n';
+          << m.start.z() << ',' << m.onset_time << ',' << m.travel_time << ',' << m.velocity << ','
+          << m.velocity_from_gate << '\n';
     std::ofstream d(out_dir / "discharge.csv");
     d << "time_after_gate_s,discharged_mass_kg\n";
     for (const auto& [t, m] : discharge_curve_) d << t << ',' << m << '\n';
