@@ -532,6 +532,9 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
 template <class Law>
 void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
   const int team = static_cast<int>(range_begin.size()) - 1;
+  // Clump members are integrated with their clump after the pass. A local copy:
+  // the stores into the accumulators could alias the member flag otherwise.
+  const std::int32_t* const clump_of = has_clumps ? p.clump.data() : nullptr;
 #pragma omp parallel num_threads(team)
   {
     const int th = omp_get_thread_num();
@@ -578,7 +581,7 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
         acc_torque[j] += tj;
       }
       addWallForces<Law>(i, f, t, local);
-      if (integrate_now && !isMember(i)) {
+      if (integrate_now && !(clump_of && clump_of[i] >= 0)) {
         integrate(i, f, t, h, local);
       } else {
         acc_force[i] = f;
