@@ -97,6 +97,12 @@ class ChuteExperiment final : public Experiment {
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override;
 
+  std::unordered_set<std::uint64_t> markerBodies() const override {
+    std::unordered_set<std::uint64_t> ids;
+    for (const Marker& m : markers_) ids.insert(m.id);
+    return ids;
+  }
+
  private:
   enum class Phase { Start, Deposit, Tilt, Flow, Done };
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "rocklab/experiments/scene.h"
@@ -33,6 +34,8 @@ class Experiment {
   virtual void observe(const sim::Snapshot& /*s*/) {}
   /// Called before every step; may replace the world. False = the experiment is over.
   virtual bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) = 0;
+  /// Ids of the marker bodies (drawn red by the cameras).
+  virtual std::unordered_set<std::uint64_t> markerBodies() const { return {}; }
   /// A few words for the progress line, e.g. "phase flow, 812 bodies left".
   virtual std::string progress() const { return {}; }
   /// Adds the figures to results.json and writes the experiment's CSV and PNG files.

@@ -13,7 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
+#include <unordered_set>
 
+#include "camera_recorder.h"
 #include "experiment.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/output/run_file.h"
@@ -162,6 +164,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
   if (world->particles().clumps.size() > 0) modules.push_back("clumps");
   if (experiment) modules.push_back("experiment:" + scene.experiment.type);
+  if (!scene.cameras.empty()) modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");
   if (scene.run.hdf5) modules.push_back("output:hdf5");
   if (scene.run.vtk) modules.push_back("output:vtk");
   if (scene.run.checkpoint) modules.push_back("output:checkpoint");
@@ -182,6 +185,15 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   log << "  steps: " << total_steps << " from t = " << world->time() << " s, output to " << options.out_dir.string()
       << "\n";
 
+  // Cameras: the GL context is made here, only when the scene has a camera.
+  std::vector<std::unique_ptr<CameraRecorder>> cameras;
+  try {
+    for (const CameraSettings& c : scene.cameras)
+      cameras.push_back(std::make_unique<CameraRecorder>(c, scene, options.out_dir, log));
+  } catch (const std::exception& e) {
+    log << "error: camera: " << e.what() << "\n";
+    return kExitBadInput;
+  }
   std::unique_ptr<out::RunFile> run_file;
   std::unique_ptr<out::VtkSeries> vtk;
   if (scene.run.hdf5) run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene_text);
@@ -195,9 +207,14 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   sim::Snapshot last;  // figures of the last observed step
   std::size_t frames = 0;
   bool frame_due = false;  // set by the loop before an observed step
-  bool experiment_due = false, energy_due = false;
+  bool experiment_due = false, energy_due = false, camera_due = false;
   auto observer = [&](const sim::Snapshot& s) {
     if (experiment_due) experiment->observe(s);
+    if (camera_due) {
+      const auto markers = experiment ? experiment->markerBodies() : std::unordered_set<std::uint64_t>{};
+      for (auto& c : cameras)
+        if (c->due(s.time)) c->record(s, world->model(), markers);
+    }
     if (!frame_due && !energy_due) return;
     const auto t0 = Clock::now();
     last.time = s.time;
@@ -241,8 +258,9 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
       frame_due = k == first_step || k + 1 >= end_step || experiment_over || (frame_every && k % frame_every == 0);
       experiment_due = experiment && !experiment_over && experiment->wantsSnapshot(k);
       energy_due = energy_every && k % energy_every == 0;
+      camera_due = std::any_of(cameras.begin(), cameras.end(), [&](const auto& c) { return c->due(world->time()); });
       ball_steps += world->particles().size();
-      if (frame_due || experiment_due || energy_due)
+      if (frame_due || experiment_due || energy_due || camera_due)
         world->step(observer);
       else
         world->step();
@@ -331,6 +349,18 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
                   {"frames", frames},
                   {"vtk_frames", vtk_frames},
                   {"checkpoint", scene.run.checkpoint && exit_code != kExitWatchdog ? "checkpoint.h5" : ""}};
+  if (!cameras.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    double render_s = 0;
+    for (auto& c : cameras) {
+      c->finish(list);
+      render_s += c->seconds();
+    }
+    r["cameras"] = list;
+    r["render_share_of_wall_time"] = render_s / std::max(1e-9, seconds(t_start, Clock::now()));
+    log << "rocklab: cameras rendered in " << render_s << " s (" << std::fixed << std::setprecision(1)
+        << 100.0 * r["render_share_of_wall_time"].get<double>() << " % of the wall time)" << std::defaultfloat << "\n";
+  }
   if (experiment) {
     r["experiment"] = scene.experiment.type;
     if (status == "completed" && !experiment_over) r["experiment_status"] = "time limit (scene.end_time) reached first";

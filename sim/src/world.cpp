@@ -868,6 +868,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
       s.force = total;
       s.radius = p.radius;
       s.id = p.id;
+      s.material = p.material;
       s.clump = p.clump;
       s.clump_position = k.position;
       s.clump_velocity = obs_clump_velocity;

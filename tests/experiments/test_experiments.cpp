@@ -105,6 +105,7 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   o.push_back("particles.0.region_max=[0.6, 0.3, 0.15]");
   o.push_back("experiment.marker_heights=[0.01, 0.03]");
   o.push_back("experiment.tilt_steps=500");
+  o.push_back("cameras.side.frame_rate=50");  // the lab's 500 fps is not needed to see a movie
   const fs::path dir = fs::temp_directory_path() / "rocklab-exp-chute";
   const json r = runFor(kAssets + "chute-30-clumps.toml", o, "chute");
   INFO(r.dump(2));
@@ -125,8 +126,13 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   CHECK(measured >= 8);
   REQUIRE(r["profile"].size() == 5);
   CHECK(r["profile"][0]["distance_m"].get<double>() == Approx(0.1));
-  for (const char* f : {"velocity_profile.png", "discharge.png", "markers.csv", "discharge.csv"})
+  for (const char* f : {"velocity_profile.png", "discharge.png", "markers.csv", "discharge.csv", "side_still_000000.png"})
     CHECK(fs::exists(dir / f));
+  // The side camera filmed it: a movie, stills, and the GL it used.
+  REQUIRE(r["cameras"].size() == 1);
+  CHECK(r["cameras"][0]["frames"].get<int>() > 50);
+  CHECK(fs::exists(dir / r["cameras"][0]["movie"].get<std::string>()));
+  CHECK(r["cameras"][0]["gl_renderer"].get<std::string>().size() > 0);
 }
 
 TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[experiment]") {
@@ -134,6 +140,8 @@ TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[ex
   o.push_back("particles.0.count=200");
   o.push_back("particles.0.region_max=[0.6, 0.3, 0.12]");
   o.push_back("experiment.tilt_steps=200");
+  o.push_back("cameras.side.movie=false");
+  o.push_back("cameras.side.frame_rate=10");
   const json r = runFor(std::string(ROCKLAB_SOURCE_DIR) + "/tests/experiments/scenes/narrow-chute.toml", o, "jam");
   CHECK(r["jammed"] == true);
   CHECK(r["clearance_time_s"].is_null());

@@ -210,3 +210,19 @@ region_max = [0.2, 0.2, 0.2]
                                   std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes"),
                     Contains("particles.1.file"));
 }
+
+TEST_CASE("camera keys are checked and a scene without cameras has none", "[scene]") {
+  const std::string file = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/chute-30-clumps.toml";
+  const Scene s = loadScene(file);
+  REQUIRE(s.cameras.size() == 1);
+  CHECK(s.cameras[0].camera.frameRate == 500.0);
+  CHECK(s.cameras[0].camera.width == 960);
+  CHECK(s.wall_looks.size() == s.model.walls.size());
+  CHECK(s.wall_looks[1].opacity == Approx(0.15));  // the camera-side Perspex
+  CHECK(loadScene(std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/drop.toml").cameras.empty());
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.resolution=[960]"}), Contains("cameras.0.resolution"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.fov_deg=200"}), Contains("cameras.0.fov_deg"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.eye=[0.27, 0.15, 0.05]"}), Contains("cameras.0.up"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.motion_blur=true"}), Contains("needs exposure > 0 s"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.lens=1"}), Contains("cameras.0.lens"));
+}

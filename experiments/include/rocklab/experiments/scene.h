@@ -3,10 +3,13 @@
 // key: an unknown key, a wrong type or a value out of range is a SceneError
 // whose message names the file, line, key, value and what is allowed.
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "rocklab/geometry/camera.h"
+#include "rocklab/render/frame.h"
 #include "rocklab/sim/model.h"
 
 namespace rocklab::experiments {
@@ -80,6 +83,34 @@ struct ClumpShapeReport {
   geometry::Vec3 principal_inertia = geometry::Vec3::Zero();  // kg m^2
 };
 
+/// A virtual camera of the scene ([[cameras]]): frames are rendered only at its
+/// frame times, never every step. A scene without cameras never creates a GL context.
+struct CameraSettings {
+  std::string name;
+  geometry::Camera camera;       // intrinsics, pose, frame rate, exposure
+  double start_time = 0.0;       // s, first frame
+  double end_time = std::numeric_limits<double>::infinity();  // s
+  bool movie = true;             // <name>.mp4 (or .avi)
+  double movie_fps = 25.0;       // playback rate of the movie, frames/s
+  double still_interval = 0.0;   // s between PNG stills (0 = none)
+  bool all_frames = false;       // every frame as PNG (for tracking)
+  bool timestamp = true;         // overlays on movie and stills (never on the all_frames PNGs)
+  bool scale_bar = true;
+  double scale_depth = 0.0;      // m along the view where the scale bar is true (0 = distance to target)
+  // Lab realism, off by default (render::RenderOptions).
+  bool motion_blur = false;
+  double noise_sigma = 0.0;      // grey levels
+  double light_gain = 1.0;
+};
+
+/// How a wall is drawn.
+struct WallLook {
+  render::Rgb colour{0.45f, 0.45f, 0.47f};
+  float opacity = 1.0f;          // < 1: transparent (the Perspex wall the lab filmed through)
+  bool visible = true;
+  double plane_size = 2.0;       // m, side of the square drawn for an infinite plane
+};
+
 struct Scene {
   std::filesystem::path source;  // file it came from ("" for text)
   std::string text;              // effective TOML (overrides applied), stored with outputs
@@ -89,6 +120,9 @@ struct Scene {
   std::vector<ClumpShapeReport> clump_shapes;
   RunSettings run;
   ExperimentSettings experiment;
+  std::vector<CameraSettings> cameras;
+  std::vector<WallLook> wall_looks;             // one per model wall
+  std::vector<render::Rgb> material_colours;    // one per material (balls)
 };
 
 /// Parses and validates a scene. `overrides` are "key.path=value" strings

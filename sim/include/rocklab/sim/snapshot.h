@@ -30,6 +30,7 @@ struct Snapshot {
   std::span<const geometry::Vec3> force;     // [n] N, total including gravity
   std::span<const double> radius;            // [n] m
   std::span<const std::uint64_t> id;         // [n]
+  std::span<const std::int32_t> material;    // [n] index into Model::materials
   // Rigid clumps (all empty without clumps). Member balls appear above too.
   std::span<const std::int32_t> clump;                 // [n] owning clump or -1
   std::span<const geometry::Vec3> clump_position;      // [c] m, centre of mass

@@ -1,0 +1,42 @@
+#pragma once
+// One scene camera during a run: renders a frame at each of its frame times
+// (the first step at or after k / frame_rate), appends it to the movie, writes
+// PNG stills (and every frame when asked), and reports what it did. The GL
+// context is created here, so a scene without cameras never has one.
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <unordered_set>
+
+#include "frame_builder.h"
+#include "rocklab/experiments/scene.h"
+#include "rocklab/render/movie.h"
+#include "rocklab/render/renderer.h"
+
+namespace rocklab::experiments {
+
+class CameraRecorder {
+ public:
+  CameraRecorder(const CameraSettings& settings, const Scene& scene, const std::filesystem::path& out_dir,
+                 std::ostream& log);
+  /// True when a frame is due at simulated time t.
+  bool due(double t) const;
+  void record(const sim::Snapshot& s, const sim::Model& model, const std::unordered_set<std::uint64_t>& markers);
+  /// Closes the movie; adds this camera's figures to `cameras` (a JSON array).
+  void finish(nlohmann::json& cameras);
+  double seconds() const { return seconds_; }
+
+ private:
+  CameraSettings settings_;
+  std::filesystem::path out_dir_;
+  FrameBuilder builder_;
+  render::Renderer renderer_;
+  std::unique_ptr<render::MovieWriter> movie_;
+  std::uint64_t frames_ = 0, stills_ = 0;
+  double next_still_ = 0.0;
+  double seconds_ = 0.0;  // wall time spent rendering and writing
+};
+
+}  // namespace rocklab::experiments

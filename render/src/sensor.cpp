@@ -1,0 +1,26 @@
+#include "sensor.h"
+
+namespace rocklab::render::detail {
+
+namespace {
+
+// splitmix64 finaliser: a well-mixed seed from (options seed, frame index).
+std::uint64_t mix(std::uint64_t a, std::uint64_t b) {
+  std::uint64_t z = a ^ (b + 0x9e3779b97f4a7c15ull + (a << 6) + (a >> 2));
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+void addSensorNoise(cv::Mat& image, double sigma, std::uint64_t seed, std::uint64_t frameIndex) {
+  cv::Mat noisy, noise(image.size(), CV_MAKETYPE(CV_32F, image.channels()));
+  cv::RNG rng(mix(seed, frameIndex));
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  image.convertTo(noisy, CV_32F);
+  noisy += noise;
+  noisy.convertTo(image, CV_8U);
+}
+
+}  // namespace rocklab::render::detail

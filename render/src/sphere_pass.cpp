@@ -1,0 +1,148 @@
+#include "sphere_pass.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace rocklab::render::detail {
+
+namespace {
+
+std::uint8_t toByte(float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+// Normalised image extent of a sphere along one axis (Mara & McGuire 2013): in the
+// plane of that axis and the optical axis the centre is (a, z); the tangents from
+// the eye have slopes (a T ∓ z r) / (z T ± a r) with T = sqrt(a² + z² − r²).
+// Needs z > r (the near-plane test guarantees it).
+std::pair<double, double> extent(double a, double z, double r) {
+  const double t = std::sqrt(a * a + z * z - r * r);
+  return {(a * t - z * r) / (z * t + a * r), (a * t + z * r) / (z * t - a * r)};
+}
+
+}  // namespace
+
+SpherePass::SpherePass(const GlApi& gl)
+    : gl_(gl),
+      program_(gl, kSphereVertexShader, kSphereFragmentShader, "sphere"),
+      uCanvasSize_(program_.uniform("canvasSize")),
+      uAsQuads_(program_.uniform("asQuads")),
+      uIntrinsics_(program_.uniform("intrinsics")),
+      uDepthMap_(program_.uniform("depthMap")),
+      uLighting_(program_.uniform("lighting")),
+      uGain_(program_.uniform("gain")) {
+  float range[2] = {1.0f, 1.0f};
+  gl.GetFloatv(GL_POINT_SIZE_RANGE, range);
+  maxPointSize_ = range[1];
+  gl.GenVertexArrays(1, &pointVao_);
+  gl.GenVertexArrays(1, &quadVao_);
+  gl.GenBuffers(1, &vbo_);
+  setAttributes(pointVao_, 0, 0);
+  gl.check("sphere pass setup");
+}
+
+SpherePass::~SpherePass() {
+  gl_.DeleteBuffers(1, &vbo_);
+  gl_.DeleteVertexArrays(1, &pointVao_);
+  gl_.DeleteVertexArrays(1, &quadVao_);
+}
+
+void SpherePass::setAttributes(GLuint vao, std::size_t firstInstance, GLuint divisor) const {
+  const auto at = [&](std::size_t member) {
+    return reinterpret_cast<const void*>(firstInstance * sizeof(Instance) + member);
+  };
+  gl_.BindVertexArray(vao);
+  gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
+  gl_.EnableVertexAttribArray(0);
+  gl_.VertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(Instance), at(offsetof(Instance, sphere)));
+  gl_.VertexAttribDivisor(0, divisor);
+  gl_.EnableVertexAttribArray(1);
+  gl_.VertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(Instance), at(offsetof(Instance, box)));
+  gl_.VertexAttribDivisor(1, divisor);
+  gl_.EnableVertexAttribArray(2);
+  gl_.VertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Instance), at(offsetof(Instance, rgba)));
+  gl_.VertexAttribDivisor(2, divisor);
+  gl_.BindVertexArray(0);
+}
+
+void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geometry::Mat3& rotation,
+                        const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip,
+                        double dt) {
+  // Side planes of the canvas frustum (through the eye, two pixels outside the
+  // canvas edges), inward unit normals: a sphere with n·c < −r is invisible.
+  const double xl = (-2.5 - canvas.cx) / canvas.fx, xr = (canvas.width + 1.5 - canvas.cx) / canvas.fx;
+  const double yt = (-2.5 - canvas.cy) / canvas.fy, yb = (canvas.height + 1.5 - canvas.cy) / canvas.fy;
+  const std::array<geometry::Vec3, 4> planes{geometry::Vec3(1, 0, -xl).normalized(), geometry::Vec3(-1, 0, xr).normalized(),
+                                             geometry::Vec3(0, 1, -yt).normalized(), geometry::Vec3(0, -1, yb).normalized()};
+  keys_.clear();
+  staged_.clear();
+  colours_.clear();
+  for (const SphereInstance& s : spheres) {
+    const geometry::Vec3 c = rotation * (s.centre + dt * s.velocity) + translation;
+    const double r = s.radius;
+    // Not drawn: crossing the near plane (the impostor needs the eye outside), wholly beyond far, outside the sides.
+    if (c.z() - r < nearClip || c.z() - r > farClip) continue;
+    bool outside = false;
+    for (const auto& n : planes) outside = outside || n.dot(c) < -r;
+    if (outside) continue;
+    keys_.push_back({c.squaredNorm() - r * r, static_cast<std::uint32_t>(staged_.size())});
+    staged_.push_back({static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()), static_cast<float>(r)});
+    colours_.push_back({toByte(s.colour.r), toByte(s.colour.g), toByte(s.colour.b), 255});
+  }
+  // Near to far for the occlusion test; then drawn far to near.
+  std::sort(keys_.begin(), keys_.end(),
+            [](const Key& a, const Key& b) { return a.power != b.power ? a.power < b.power : a.index < b.index; });
+  order_.resize(keys_.size());
+  for (std::size_t k = 0; k < keys_.size(); ++k) order_[k] = keys_[k].index;
+  const std::vector<std::uint8_t>& visible = culler_.cull(staged_, order_, canvas);
+
+  instances_.clear();
+  quadInstances_.clear();
+  const double margin = 0.6;  // pixels: the soft edge reaches half a pixel beyond the silhouette
+  for (auto k = order_.rbegin(); k != order_.rend(); ++k) {
+    if (!visible[*k]) continue;
+    const CameraSphere& s = staged_[*k];
+    const auto [x0, x1] = extent(s.x, s.z, s.radius);
+    const auto [y0, y1] = extent(s.y, s.z, s.radius);
+    const double u0 = canvas.fx * x0 + canvas.cx - margin, u1 = canvas.fx * x1 + canvas.cx + margin;
+    const double v0 = canvas.fy * y0 + canvas.cy - margin, v1 = canvas.fy * y1 + canvas.cy + margin;
+    const Instance instance{{s.x, s.y, s.z, s.radius},
+                            {static_cast<float>(u0), static_cast<float>(v0), static_cast<float>(u1), static_cast<float>(v1)},
+                            {colours_[*k][0], colours_[*k][1], colours_[*k][2], colours_[*k][3]}};
+    // Points are clipped by their centre, so only boxes inside the canvas are points.
+    const bool inside = u0 >= 0 && v0 >= 0 && u1 <= canvas.width - 1 && v1 <= canvas.height - 1;
+    const bool fits = std::max(u1 - u0, v1 - v0) + 1.0 <= maxPointSize_;
+    (inside && fits ? instances_ : quadInstances_).push_back(instance);
+  }
+  points_ = instances_.size();
+  quads_ = quadInstances_.size();
+  occluded_ = staged_.size() - points_ - quads_;
+  instances_.insert(instances_.end(), quadInstances_.begin(), quadInstances_.end());
+  gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
+  gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(instances_.size() * sizeof(Instance)), instances_.data(),
+                 GL_STREAM_DRAW);
+  if (quads_ > 0) setAttributes(quadVao_, points_, 1);
+}
+
+void SpherePass::draw(const ViewUniforms& view, const Canvas& canvas) const {
+  if (points_ + quads_ == 0) return;
+  gl_.UseProgram(program_.id());
+  gl_.Uniform2f(uCanvasSize_, static_cast<float>(canvas.width), static_cast<float>(canvas.height));
+  gl_.Uniform4f(uIntrinsics_, view.intrinsics[0], view.intrinsics[1], view.intrinsics[2], view.intrinsics[3]);
+  gl_.Uniform2f(uDepthMap_, view.depthMap[0], view.depthMap[1]);
+  gl_.Uniform4f(uLighting_, view.lighting[0], view.lighting[1], view.lighting[2], view.lighting[3]);
+  gl_.Uniform1f(uGain_, view.gain);
+  if (points_ > 0) {
+    gl_.Enable(GL_PROGRAM_POINT_SIZE);
+    gl_.Uniform1i(uAsQuads_, 0);
+    gl_.BindVertexArray(pointVao_);
+    gl_.DrawArrays(GL_POINTS, 0, static_cast<GLsizei>(points_));
+  }
+  if (quads_ > 0) {
+    gl_.Uniform1i(uAsQuads_, 1);
+    gl_.BindVertexArray(quadVao_);
+    gl_.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(quads_));
+  }
+  gl_.BindVertexArray(0);
+}
+
+}  // namespace rocklab::render::detail

@@ -1,0 +1,244 @@
+// What the image looks like: colours, determinism, the golden image, realism options, validation.
+//
+// Golden image: tests/render/golden/tiny_scene.png. After an intended change of
+// the look, rewrite it with
+//   ROCKLAB_UPDATE_GOLDEN=1 ./build/tests/render_tests "golden*"
+// and look at the new PNG before committing it.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "render_scenes.h"
+#include "rocklab/render/image_io.h"
+#include "rocklab/render/renderer.h"
+
+using namespace rocklab::render;
+using namespace rocklab::render::test;
+
+namespace {
+
+Camera smallCamera() {
+  Camera c = labCamera();
+  c.width = 160;
+  c.height = 120;
+  c.fx = c.fy = 200.0;
+  c.cx = 79.5;
+  c.cy = 59.5;
+  return c;
+}
+
+std::string invalidMessage(const auto& make) {
+  try {
+    make();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("no GL context exists before a Renderer and none after it", "[render]") {
+  CHECK(liveGlContexts() == 0);
+  {
+    Renderer renderer(smallCamera());
+    CHECK(liveGlContexts() == 1);
+    std::printf("GL_VERSION %s | GL_RENDERER %s | core profile %s\n", renderer.glVersion().c_str(),
+                renderer.glRenderer().c_str(), renderer.coreProfile() ? "yes" : "no (compatibility fallback)");
+    CHECK(!renderer.glVersion().empty());
+    CHECK(!renderer.glRenderer().empty());
+  }
+  CHECK(liveGlContexts() == 0);
+}
+
+TEST_CASE("red markers and grey pebbles are separable by r minus g", "[render]") {
+  const Camera camera = labCamera();
+  const Vec3 marker(-0.03, 0, 0.02), pebble(0.03, 0, 0.02);
+  const double radius = 0.015;
+  FrameDescription frame;
+  frame.spheres.push_back({marker, radius, kRedMarker, Vec3::Zero()});
+  frame.spheres.push_back({pebble, radius, kGreyPebble, Vec3::Zero()});
+  Renderer renderer(camera);
+  for (double gain : {0.8, 1.0, 1.25}) {
+    frame.lightGain = gain;
+    const cv::Mat image = renderer.render(frame);
+    // Interior pixels (1.5 px inside the silhouette) of each sphere, and the rest.
+    const double rm = radius * camera.fx / camera.toCamera(marker).z() - 1.5;
+    const double rp = radius * camera.fx / camera.toCamera(pebble).z() - 1.5;
+    const Vec2 cm = camera.project(marker), cp = camera.project(pebble);
+    int minMarker = 255, maxPebble = -255, maxBackground = -255;
+    for (int v = 0; v < image.rows; ++v)
+      for (int u = 0; u < image.cols; ++u) {
+        const cv::Vec3b p = image.at<cv::Vec3b>(v, u);
+        const int rg = int(p[2]) - int(p[1]);
+        const double dm = (Vec2(u, v) - cm).norm(), dp = (Vec2(u, v) - cp).norm();
+        if (dm < rm) minMarker = std::min(minMarker, rg);
+        else if (dp < rp) maxPebble = std::max(maxPebble, rg);
+        else if (dm > rm + 3 && dp > rp + 3) maxBackground = std::max(maxBackground, rg);
+      }
+    std::printf("gain %.2f: r-g marker >= %d, pebble <= %d, background <= %d\n", gain, minMarker, maxPebble, maxBackground);
+    CHECK(minMarker > 40);
+    CHECK(maxPebble < 15);
+    CHECK(maxBackground < 15);
+  }
+}
+
+TEST_CASE("two renders of the same frame are bitwise identical", "[render]") {
+  const FrameDescription frame = tinyScene();
+  Renderer a(labCamera(-0.1, 0.02));
+  const cv::Mat first = a.render(frame);
+  CHECK(cv::norm(first, a.render(frame), cv::NORM_INF) == 0);
+  Renderer b(labCamera(-0.1, 0.02));  // a second context
+  CHECK(cv::norm(first, b.render(frame), cv::NORM_INF) == 0);
+  // With every realism option on, too (noise seeded by the frame index).
+  Camera blurred = labCamera();
+  blurred.exposureTime = 1.0 / 1000;
+  RenderOptions lab;
+  lab.motionBlur = true;
+  lab.noiseSigma = 3.0;
+  Renderer c(blurred, lab);
+  FrameDescription moving = frame;
+  for (auto& s : moving.spheres) s.velocity = Vec3(2.0, 0, -1.0);
+  CHECK(cv::norm(c.render(moving), c.render(moving), cv::NORM_INF) == 0);
+}
+
+TEST_CASE("golden image of a tiny scene", "[render][golden]") {
+  Renderer renderer(smallCamera());
+  const cv::Mat image = renderer.render(tinyScene());
+  const std::filesystem::path golden = std::filesystem::path(ROCKLAB_SOURCE_DIR) / "tests/render/golden/tiny_scene.png";
+  if (const char* update = std::getenv("ROCKLAB_UPDATE_GOLDEN"); update && std::string(update) == "1") {
+    writePng(golden, image);
+    WARN("rewrote " << golden);
+  }
+  const cv::Mat expected = cv::imread(golden.string(), cv::IMREAD_COLOR);
+  REQUIRE_FALSE(expected.empty());  // missing: run once with ROCKLAB_UPDATE_GOLDEN=1
+  REQUIRE(expected.size() == image.size());
+  cv::Mat diff;
+  cv::absdiff(image, expected, diff);
+  const double meanAbs = cv::mean(diff.reshape(1))[0];
+  double maxAbs = 0;
+  cv::minMaxLoc(diff.reshape(1), nullptr, &maxAbs);
+  std::printf("golden: mean |diff| %.4f, max %.0f grey levels\n", meanAbs, maxAbs);
+  if (meanAbs >= 0.5) writePng(std::filesystem::path(ROCKLAB_BINARY_DIR) / "tests/render_golden_actual.png", image);
+  CHECK(meanAbs < 0.5);
+}
+
+TEST_CASE("the compatibility fallback draws the same image as the core profile", "[render]") {
+  RenderOptions compat;
+  compat.profile = GlProfile::Compatibility;
+  Renderer core(smallCamera()), fallback(smallCamera(), compat);
+  CHECK_FALSE(fallback.coreProfile());
+  std::printf("fallback GL_VERSION %s\n", fallback.glVersion().c_str());
+  CHECK(cv::norm(core.render(tinyScene()), fallback.render(tinyScene()), cv::NORM_INF) == 0);
+}
+
+TEST_CASE("motion blur smears a moving sphere along its velocity about the same centre", "[render]") {
+  Camera camera = labCamera();
+  camera.exposureTime = 1.0 / 500;
+  RenderOptions blur;
+  blur.motionBlur = true;
+  blur.motionBlurSubframes = 16;
+  blur.ambient = 1.0f, blur.diffuse = 0.0f, blur.specular = 0.0f;
+  FrameDescription frame;
+  frame.background = {0, 0, 0};
+  const Vec3 centre(0, 0, 0.05);
+  const Vec3 velocity = 5.0 * camera.rotation.row(0).transpose();  // 5 m/s along image x
+  frame.spheres.push_back({centre, 0.004, {1, 1, 1}, velocity});
+  Renderer still(camera), moving(camera, blur);
+  const cv::Mat a = still.render(frame), b = moving.render(frame);
+  auto extent = [](const cv::Mat& m) {
+    cv::Mat grey, mask;
+    cv::cvtColor(m, grey, cv::COLOR_BGR2GRAY);
+    const cv::Moments mo = cv::moments(grey);
+    cv::threshold(grey, mask, 8, 255, cv::THRESH_BINARY);
+    const cv::Rect box = cv::boundingRect(mask);
+    return std::pair{Vec2(mo.m10 / mo.m00, mo.m01 / mo.m00), box};
+  };
+  const auto [ca, boxA] = extent(a);
+  const auto [cb, boxB] = extent(b);
+  const double smear = 5.0 * camera.exposureTime * camera.fx / camera.toCamera(centre).z();  // px
+  std::printf("motion blur: smear %.2f px expected, width %d -> %d px, centroid shift %.3f px\n", smear, boxA.width,
+              boxB.width, (ca - cb).norm());
+  CHECK(std::abs((boxB.width - boxA.width) - smear) < 2.0);
+  CHECK(std::abs(boxB.height - boxA.height) <= 1);
+  CHECK((ca - cb).norm() < 0.1);
+}
+
+TEST_CASE("sensor noise is seeded by the frame index and has the asked sigma", "[render]") {
+  RenderOptions noisy;
+  noisy.noiseSigma = 4.0;
+  noisy.noiseSeed = 7;
+  Renderer clean(smallCamera()), sensor(smallCamera(), noisy);
+  FrameDescription frame = tinyScene();
+  const cv::Mat reference = clean.render(frame);
+  frame.index = 3;
+  const cv::Mat n3 = sensor.render(frame);
+  frame.index = 4;
+  const cv::Mat n4 = sensor.render(frame);
+  CHECK(cv::norm(n3, n4, cv::NORM_INF) > 0);
+  frame.index = 3;
+  CHECK(cv::norm(n3, sensor.render(frame), cv::NORM_INF) == 0);
+  cv::Mat diff;
+  cv::subtract(n3, reference, diff, cv::noArray(), CV_32F);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(diff.reshape(1), mean, sd);
+  CHECK(std::abs(mean[0]) < 0.2);
+  CHECK(sd[0] == Approx(4.0).epsilon(0.05));
+}
+
+TEST_CASE("light gain scales the background and the lit colours", "[render]") {
+  Renderer renderer(smallCamera());
+  FrameDescription frame;
+  frame.background = {0.2f, 0.4f, 0.6f};
+  frame.lightGain = 0.5;
+  const cv::Vec3b p = renderer.render(frame).at<cv::Vec3b>(0, 0);
+  const cv::Vec3b expected(77, 51, 26);  // BGR of 0.5 × 255 × (0.6, 0.4, 0.2), rounded
+  for (int ch = 0; ch < 3; ++ch) CHECK(std::abs(int(p[ch]) - int(expected[ch])) <= 1);
+}
+
+TEST_CASE("bad input throws std::invalid_argument naming the field", "[render]") {
+  using Catch::Matchers::StartsWith;
+  Camera noFocal = smallCamera();
+  noFocal.fx = 0;
+  CHECK_THAT(invalidMessage([&] { Renderer r(noFocal); }), StartsWith("camera.fx"));
+  Camera empty = smallCamera();
+  empty.height = 0;
+  CHECK_THAT(invalidMessage([&] { Renderer r(empty); }), StartsWith("camera.height"));
+  Camera skew = smallCamera();
+  skew.rotation(0, 0) *= 1.01;
+  CHECK_THAT(invalidMessage([&] { Renderer r(skew); }), StartsWith("camera.rotation"));
+  RenderOptions options;
+  options.farClip = options.nearClip;
+  CHECK_THAT(invalidMessage([&] { Renderer r(smallCamera(), options); }), StartsWith("render options.farClip"));
+  CHECK(liveGlContexts() == 0);  // nothing was created for invalid input
+
+  Renderer renderer(smallCamera());
+  FrameDescription frame = tinyScene();
+  frame.spheres[2].radius = -1;
+  CHECK_THAT(invalidMessage([&] { renderer.render(frame); }), StartsWith("frame.spheres[2].radius"));
+  frame = tinyScene();
+  frame.polygons[1].vertices.resize(2);
+  CHECK_THAT(invalidMessage([&] { renderer.render(frame); }), StartsWith("frame.polygons[1].vertices"));
+  CHECK_THAT(invalidMessage([&] { renderer.setCamera(noFocal); }), StartsWith("camera.fx"));
+}
+
+TEST_CASE("the cached wall layer follows wall and camera changes", "[render]") {
+  Renderer renderer(smallCamera());
+  FrameDescription frame = tinyScene();
+  (void)renderer.render(frame);
+  frame.polygons[0].colour = {0.7f, 0.2f, 0.2f};
+  frame.meshes[0].translation = Vec3(-0.02, 0.0, 0.0);
+  frame.background = {0.3f, 0.3f, 0.1f};
+  CHECK(cv::norm(renderer.render(frame), Renderer(smallCamera()).render(frame), cv::NORM_INF) == 0);
+  Camera moved = smallCamera();
+  moved.lookAt(Vec3(0.15, -0.5, 0.3), Vec3(0.0, 0.0, 0.03), Vec3(0, 0, 1));
+  renderer.setCamera(moved);
+  CHECK(cv::norm(renderer.render(frame), Renderer(moved).render(frame), cv::NORM_INF) == 0);
+}
