@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "rocklab/experiments/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/sweep.h"
@@ -27,6 +28,7 @@ Examples:
   rocklab calibrate drop --vary contact.damping_normal=0:0.4 --target restitution=0.72
   rocklab calibrate heap --vary materials.pebble.friction=0.2,0.3,0.4,0.5 --target angle_of_repose_deg=26.03
   rocklab sweep chute-30-clumps --vary experiment.inclination_deg=27,30,33   # one table + plot
+  rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
 
 Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
 watchdog, 130 interrupted by Ctrl-C (outputs so far are kept and readable).
@@ -90,6 +92,11 @@ int runCli(int argc, const char* const* argv) {
   check->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", overrides, "Override a scene key")->take_all();
   app.add_subcommand("list", "List the built-in scenes");
+  std::string camera_file;
+  auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
+  render->add_option("run", checkpoint_arg, "run.h5 written by an earlier run")->required();
+  render->add_option("--camera", camera_file, "TOML file with [[cameras]] tables (default: the scene's cameras)");
+  render->add_option("--out", out_dir, "Output directory (default: the run file's folder)");
   std::vector<std::string> vary, metrics;
   std::string target;
   int iterations = 8;
@@ -121,6 +128,7 @@ int runCli(int argc, const char* const* argv) {
   }
 
   if (app.got_subcommand("list")) return doList();
+  if (app.got_subcommand("render")) return renderRun({checkpoint_arg, camera_file, out_dir}, std::cerr);
   if (app.got_subcommand("sweep") || app.got_subcommand("calibrate")) {
     SweepOptions so;
     so.scene = scene_arg;

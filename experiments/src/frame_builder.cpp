@@ -46,7 +46,8 @@ render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const si
   for (std::size_t k = 0; k < model.walls.size() && k < looks_.size(); ++k) {
     const sim::Wall& w = model.walls[k];
     const WallLook& look = looks_[k];
-    if (!look.visible || !w.activeAt(s.time)) continue;
+    const bool active = k < s.wall_active.size() ? s.wall_active[k] != 0 : w.activeAt(s.time);
+    if (!look.visible || !active) continue;
     if (w.shape == sim::WallShape::Mesh) {
       render::MeshInstance mesh;
       mesh.mesh = meshes_[k];

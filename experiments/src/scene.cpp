@@ -664,6 +664,20 @@ Scene loadScene(const std::filesystem::path& path, const std::vector<std::string
   return scene;
 }
 
+std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path.string() + ": cannot open the camera file (does it exist?)");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  const toml::table table = parseToml(buf.str(), path.string());
+  TableReader root(table, "");
+  std::vector<CameraSettings> cameras;
+  readCameras(root, cameras);
+  root.finish();
+  if (cameras.empty()) throw SceneError(path.string() + ": no [[cameras]] table");
+  return cameras;
+}
+
 std::filesystem::path builtinSceneDir() { return std::filesystem::path(ROCKLAB_ASSET_DIR) / "scenes"; }
 
 std::filesystem::path resolveScene(const std::string& name_or_path) {

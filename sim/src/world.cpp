@@ -869,6 +869,9 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
       s.radius = p.radius;
       s.id = p.id;
       s.material = p.material;
+      std::vector<std::uint8_t> active(walls.size());
+      for (std::size_t w = 0; w < walls.size(); ++w) active[w] = walls[w].active ? 1 : 0;
+      s.wall_active = active;
       s.clump = p.clump;
       s.clump_position = k.position;
       s.clump_velocity = obs_clump_velocity;

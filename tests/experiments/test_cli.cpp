@@ -100,3 +100,22 @@ TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and r
   file.close();
   fs::remove_all(out);
 }
+
+TEST_CASE("render re-renders a stored run from another camera", "[cli]") {
+  const fs::path out = tempDir("render");
+  REQUIRE(cli({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=0.004", "--set",
+               "particles.0.count=200", "--set", "output.frame_interval=0.001"}) == 0);
+  const fs::path camera = out / "top.toml";
+  std::ofstream(camera) << "[[cameras]]\nname = \"top\"\nresolution = [320, 240]\nfov_deg = 60.0\n"
+                           "eye = [0.0, 0.0, 1.5]\ntarget = [0.0, 0.0, 0.3]\nup = [1.0, 0.0, 0.0]\n";
+  REQUIRE(cli({"render", (out / "run.h5").string(), "--camera", camera.string(), "--out", (out / "top").string()}) == 0);
+  const fs::path movie = fs::exists(out / "top" / "top.mp4") ? out / "top" / "top.mp4" : out / "top" / "top.avi";
+  REQUIRE(fs::exists(movie));
+  CHECK(fs::file_size(movie) > 0);
+  // Bad input: an unknown camera key, a missing run file, a scene without cameras.
+  std::ofstream(out / "bad.toml") << "[[cameras]]\nname = \"x\"\nfov_deg = 60.0\neye = [0, 0, 1]\ntarget = [0, 0, 0]\n"
+                                     "up = [1, 0, 0]\nzoom = 2\n";
+  CHECK(cli({"render", (out / "run.h5").string(), "--camera", (out / "bad.toml").string()}) == 2);
+  CHECK(cli({"render", (out / "nothing.h5").string(), "--camera", camera.string()}) == 2);
+  CHECK(cli({"render", (out / "run.h5").string()}) == 2);
+}

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,11 @@ struct Layout<std::uint64_t> {
 template <>
 struct Layout<std::uint32_t> {
   static const H5::PredType& type() { return H5::PredType::NATIVE_UINT32; }
+  static constexpr hsize_t columns = 0;
+};
+template <>
+struct Layout<std::uint8_t> {
+  static const H5::PredType& type() { return H5::PredType::NATIVE_UINT8; }
   static constexpr hsize_t columns = 0;
 };
 template <>
@@ -91,6 +97,24 @@ template <class T>
 void writeArray(const H5::Group& group, const char* name, const std::vector<T>& values,
                 const char* unit) {
   writeArray(group, name, std::span<const T>(values), unit);
+}
+
+/// Reads a dataset written by writeArray ([n] or [n,columns]); empty when absent.
+/// Throws std::runtime_error when its shape does not fit T.
+template <class T>
+std::vector<T> readArray(const H5::Group& group, const char* name) {
+  if (!group.nameExists(name)) return {};
+  const H5::DataSet dataset = group.openDataSet(name);
+  const H5::DataSpace space = dataset.getSpace();
+  std::array<hsize_t, 2> dims{0, 0};
+  const int rank = space.getSimpleExtentNdims();
+  if (rank < 1 || rank > 2) throw std::runtime_error(std::string("dataset ") + name + " has rank " + std::to_string(rank));
+  space.getSimpleExtentDims(dims.data());
+  if ((rank == 1) != (Layout<T>::columns == 0) || (rank == 2 && dims[1] != Layout<T>::columns))
+    throw std::runtime_error(std::string("dataset ") + name + " has the wrong shape");
+  std::vector<T> values(dims[0]);
+  if (!values.empty()) dataset.read(values.data(), Layout<T>::type());
+  return values;
 }
 
 /// Writes `text` as a scalar string dataset with an empty "unit" attribute.

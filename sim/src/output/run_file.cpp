@@ -2,6 +2,7 @@
 
 #include <H5Cpp.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstdio>
@@ -131,6 +132,8 @@ void RunFile::writeFrame(const Snapshot& snapshot) {
     writeArray(frame, "force", snapshot.force, "N");
     writeArray(frame, "radius", snapshot.radius, "m");
     writeArray(frame, "id", snapshot.id, "");
+    if (!snapshot.material.empty()) writeArray(frame, "material", snapshot.material, "");
+    if (!snapshot.wall_active.empty()) writeArray(frame, "wall_active", snapshot.wall_active, "");
     if (!snapshot.clump_id.empty()) {
       writeArray(frame, "clump", snapshot.clump, "");
       writeArray(frame, "clump_position", snapshot.clump_position, "m");
@@ -191,6 +194,97 @@ void RunFile::close(bool interrupted) {
   if (error) {
     throw std::runtime_error("run file: cannot rename '" + impl_->partial.string() + "' to '" +
                              impl_->path.string() + "': " + error.message());
+  }
+}
+
+}  // namespace rocklab::sim::output
+
+namespace rocklab::sim::output {
+
+struct RunFileReader::Impl {
+  std::filesystem::path path;
+  H5::H5File file;
+  std::string scene;
+  std::vector<std::string> frame_names;
+  // Storage of the current frame.
+  std::vector<Vec3> position, velocity, omega, force, clump_position, clump_velocity, clump_omega, clump_force;
+  std::vector<double> radius;
+  std::vector<std::uint64_t> id, clump_id;
+  std::vector<std::int32_t> material, clump;
+  std::vector<std::uint8_t> wall_active;
+  std::vector<Quat> clump_orientation;
+  Snapshot snapshot;
+};
+
+RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+  H5::Exception::dontPrint();
+  impl_->path = path;
+  const std::string where = "run file '" + path.string() + "': ";
+  try {
+    if (!std::filesystem::exists(path)) throw std::runtime_error(where + "does not exist");
+    if (!H5::H5File::isHdf5(path.string())) throw std::runtime_error(where + "not an HDF5 file");
+    impl_->file = H5::H5File(path.string(), H5F_ACC_RDONLY);
+    if (!impl_->file.nameExists("scene") || !impl_->file.nameExists("frames"))
+      throw std::runtime_error(where + "not a rocklab run file (no /scene or /frames)");
+    const H5::DataSet scene = impl_->file.openDataSet("scene");
+    scene.read(impl_->scene, scene.getStrType());
+    const H5::Group frames = impl_->file.openGroup("frames");
+    for (hsize_t k = 0; k < frames.getNumObjs(); ++k) impl_->frame_names.push_back(frames.getObjnameByIdx(k));
+    std::sort(impl_->frame_names.begin(), impl_->frame_names.end());  // 000000, 000001, ...
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error(where + e.getDetailMsg());
+  }
+}
+
+RunFileReader::~RunFileReader() = default;
+
+const std::string& RunFileReader::sceneText() const { return impl_->scene; }
+std::size_t RunFileReader::frameCount() const { return impl_->frame_names.size(); }
+
+const Snapshot& RunFileReader::frame(std::size_t k) {
+  Impl& m = *impl_;
+  using detail::readArray;
+  try {
+    const H5::Group g = m.file.openGroup("frames/" + m.frame_names.at(k));
+    Snapshot& s = m.snapshot;
+    s = Snapshot{};
+    g.openAttribute("time").read(H5::PredType::NATIVE_DOUBLE, &s.time);
+    g.openAttribute("step").read(H5::PredType::NATIVE_UINT64, &s.step);
+    m.position = readArray<Vec3>(g, "position");
+    m.velocity = readArray<Vec3>(g, "velocity");
+    m.omega = readArray<Vec3>(g, "omega");
+    m.force = readArray<Vec3>(g, "force");
+    m.radius = readArray<double>(g, "radius");
+    m.id = readArray<std::uint64_t>(g, "id");
+    m.material = readArray<std::int32_t>(g, "material");
+    m.wall_active = readArray<std::uint8_t>(g, "wall_active");
+    m.clump = readArray<std::int32_t>(g, "clump");
+    m.clump_position = readArray<Vec3>(g, "clump_position");
+    m.clump_velocity = readArray<Vec3>(g, "clump_velocity");
+    m.clump_omega = readArray<Vec3>(g, "clump_omega");
+    m.clump_orientation = readArray<Quat>(g, "clump_orientation");
+    m.clump_id = readArray<std::uint64_t>(g, "clump_id");
+    if (m.material.empty()) m.material.assign(m.position.size(), 0);  // files from before materials were stored
+    s.position = m.position;
+    s.velocity = m.velocity;
+    s.omega = m.omega;
+    s.force = m.force;
+    s.radius = m.radius;
+    s.id = m.id;
+    s.material = m.material;
+    s.wall_active = m.wall_active;
+    s.clump = m.clump;
+    s.clump_position = m.clump_position;
+    s.clump_velocity = m.clump_velocity;
+    s.clump_omega = m.clump_omega;
+    s.clump_orientation = m.clump_orientation;
+    s.clump_id = m.clump_id;
+    detail::particleCount(s);
+    return s;
+  } catch (const H5::Exception& e) {
+    throw std::runtime_error("run file '" + m.path.string() + "' frame " + std::to_string(k) + ": " + e.getDetailMsg());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("run file '" + m.path.string() + "' frame " + std::to_string(k) + ": " + e.what());
   }
 }
 

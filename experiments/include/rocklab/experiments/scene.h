@@ -132,6 +132,9 @@ Scene loadSceneText(const std::string& text, const std::string& source_name,
                     const std::vector<std::string>& overrides = {},
                     const std::filesystem::path& base_dir = {});
 
+/// Reads the [[cameras]] tables of a camera file (the same keys as in a scene).
+std::vector<CameraSettings> loadCameras(const std::filesystem::path& path);
+
 /// Directory of the built-in scenes, and the resolution of a bare name ("pour")
 /// to a file in it.
 std::filesystem::path builtinSceneDir();

@@ -31,6 +31,7 @@ struct Snapshot {
   std::span<const double> radius;            // [n] m
   std::span<const std::uint64_t> id;         // [n]
   std::span<const std::int32_t> material;    // [n] index into Model::materials
+  std::span<const std::uint8_t> wall_active; // [walls] 1 when the wall exists at `time`
   // Rigid clumps (all empty without clumps). Member balls appear above too.
   std::span<const std::int32_t> clump;                 // [n] owning clump or -1
   std::span<const geometry::Vec3> clump_position;      // [c] m, centre of mass

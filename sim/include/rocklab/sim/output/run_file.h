@@ -7,7 +7,8 @@
 //   /scene                 string dataset: the scene file text as run (after --set overrides)
 //   /frames/000000, ...    one group per frame, attrs time (s), step;
 //                          datasets position [n,3] m, velocity [n,3] m/s, omega [n,3] rad/s,
-//                          force [n,3] N, radius [n] m, id [n] uint64
+//                          force [n,3] N, radius [n] m, id [n] uint64, material [n] int32,
+//                          wall_active [walls] uint8 (1 = the wall exists in this frame)
 //                          with clumps also: clump [n] int32 (owning clump, -1 free),
 //                          clump_position [c,3] m, clump_velocity [c,3] m/s, clump_omega [c,3]
 //                          rad/s, clump_orientation [c,4] (x, y, z, w; body -> world), clump_id [c]
@@ -38,6 +39,26 @@ class RunFile {
   std::size_t frameCount() const;
   /// Marks the file complete (or interrupted), closes it and renames it into place.
   void close(bool interrupted);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Reads a run.h5 (or its .partial) back: the scene text and the frames, for
+/// re-rendering from another camera or for analysis. Throws std::runtime_error
+/// naming the file when it is not a rocklab run file.
+class RunFileReader {
+ public:
+  explicit RunFileReader(const std::filesystem::path& path);
+  ~RunFileReader();
+  RunFileReader(const RunFileReader&) = delete;
+  RunFileReader& operator=(const RunFileReader&) = delete;
+
+  const std::string& sceneText() const;
+  std::size_t frameCount() const;
+  /// Frame k as a snapshot (energy not included); valid until the next call.
+  const Snapshot& frame(std::size_t k);
 
  private:
   struct Impl;

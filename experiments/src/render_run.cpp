@@ -1,0 +1,62 @@
+#include "rocklab/experiments/render_run.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <unordered_set>
+
+#include "camera_recorder.h"
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+#include "rocklab/sim/output/run_file.h"
+
+namespace rocklab::experiments {
+
+int renderRun(const RenderRunOptions& o, std::ostream& log) {
+  try {
+    sim::output::RunFileReader run(o.run_file);
+    const Scene scene = loadSceneText(run.sceneText(), o.run_file.string() + ":/scene", {}, o.run_file.parent_path());
+    std::vector<CameraSettings> cameras = o.camera_file.empty() ? scene.cameras : loadCameras(o.camera_file);
+    if (cameras.empty()) {
+      log << "error: " << o.run_file.string() << ": the stored scene has no [[cameras]]; give --camera CAMERA.toml\n";
+      return kExitBadInput;
+    }
+    if (run.frameCount() == 0) {
+      log << "error: " << o.run_file.string() << ": no frames stored (set output.frame_interval when running)\n";
+      return kExitBadInput;
+    }
+    // Markers: the ids the chute chose, from results.json beside the run.
+    std::unordered_set<std::uint64_t> markers;
+    std::ifstream results(o.run_file.parent_path() / "results.json");
+    if (results) {
+      const nlohmann::json r = nlohmann::json::parse(results, nullptr, false);
+      if (r.is_object() && r.contains("markers"))
+        for (const auto& m : r["markers"]) markers.insert(m["id"].get<std::uint64_t>());
+    }
+    const std::filesystem::path out = o.out_dir.empty() ? o.run_file.parent_path() : o.out_dir;
+    std::filesystem::create_directories(out);
+    std::vector<std::unique_ptr<CameraRecorder>> recorders;
+    for (CameraSettings c : cameras) {
+      c.start_time = 0.0;  // every stored frame, whatever the camera's own timing
+      recorders.push_back(std::make_unique<CameraRecorder>(c, scene, out, log));
+    }
+    for (std::size_t k = 0; k < run.frameCount(); ++k) {
+      const sim::Snapshot& s = run.frame(k);
+      for (auto& r : recorders) r->record(s, scene.model, markers);
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (auto& r : recorders) r->finish(list);
+    for (const auto& c : list)
+      log << "render: camera '" << c["name"].get<std::string>() << "': " << c["frames"] << " frames in "
+          << c["render_s"].get<double>() << " s" << (c.contains("movie") ? ", movie " + c["movie"].get<std::string>() : "")
+          << " in " << out.string() << "\n";
+    return kExitOk;
+  } catch (const SceneError& e) {
+    log << "error: " << e.what() << "\n";
+  } catch (const std::exception& e) {
+    log << "error: " << e.what() << "\n";
+  }
+  return kExitBadInput;
+}
+
+}  // namespace rocklab::experiments
