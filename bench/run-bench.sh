@@ -3,9 +3,11 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|grid|all] [small|full] [OUTDIR]
+# Usage: bench/run-bench.sh [settle|dense|grid|render|all] [small|full] [OUTDIR]
 #   scene  settle (contact-sparse), dense (contact-rich), grid (7:1 size ratio:
-#          multi-level against single-level neighbour grid, rocklab only) or all (default)
+#          multi-level against single-level neighbour grid, rocklab only), render
+#          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
+#          1280x1024, rocklab only) or all (default)
 #   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
 #   OUTDIR logs and results (default: a new temporary directory)
 # Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install liggghts`.
@@ -100,4 +102,11 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = grid ]; then
       "$(json "$dir/results.json" steps)" "$rb" "$(echo "1000 * $(json "$dir/results.json" neighbour_search_s) / $rb" | bc -l)" \
       "$(json "$dir/results.json" particle_steps_per_s)"
   done
+fi
+
+# Renderer: frames per second for a chute-like frame of 7,000 spheres.
+if [ "$which_scenes" = all ] || [ "$which_scenes" = render ]; then
+  cmake --build "$root/build" --target render_benchmark >/dev/null
+  printf '\nrender\n'
+  "$root/build/tests/render_benchmark"
 fi
