@@ -56,6 +56,9 @@ void CameraRecorder::record(const sim::Snapshot& s, const sim::Model& model,
   render::FrameDescription frame = builder_.describe(s, model, markers, frames_);
   frame.lightGain = settings_.light_gain;
   cv::Mat image = renderer_.render(frame);
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (on_frame) on_frame(frames_, s.time, image);  // its time is the tracker's, not the camera's
+  const auto t1 = std::chrono::steady_clock::now();
   if (settings_.all_frames) render::writePng(out_dir_ / "frames" / settings_.name / numbered("frame", frames_), image);
   const bool still = settings_.still_interval > 0 && s.time >= next_still_ - 1e-12;
   if (movie_ || still) {
@@ -69,7 +72,7 @@ void CameraRecorder::record(const sim::Snapshot& s, const sim::Model& model,
     }
   }
   ++frames_;
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 }
 
 void CameraRecorder::finish(nlohmann::json& cameras) {

@@ -5,6 +5,7 @@
 // context is created here, so a scene without cameras never has one.
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -27,6 +28,9 @@ class CameraRecorder {
   /// Closes the movie; adds this camera's figures to `cameras` (a JSON array).
   void finish(nlohmann::json& cameras);
   double seconds() const { return seconds_; }
+  const CameraSettings& settings() const { return settings_; }
+  /// Called with every raw frame (no overlays), e.g. for marker tracking.
+  std::function<void(std::uint64_t frame, double time, const cv::Mat& raw)> on_frame;
 
  private:
   CameraSettings settings_;

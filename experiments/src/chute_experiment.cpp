@@ -23,7 +23,9 @@
 #include <unordered_set>
 
 #include "experiment.h"
+#include "marker_tracking.h"
 #include "plot.h"
+#include "rocklab/track/export.h"
 
 namespace rocklab::experiments {
 
@@ -50,7 +52,18 @@ nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 class ChuteExperiment final : public Experiment {
  public:
-  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {}
+  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {
+    for (const CameraSettings& c : scene.cameras)
+      if (c.name == e_.track_camera) tracking_ = std::make_unique<MarkerTracking>(c.camera, e_.measure_distance);
+    // Size of a marker pebble: the clump's equivalent sphere, or the largest sphere.
+    if (!scene.clump_shapes.empty()) marker_radius_ = 0.5 * scene.clump_shapes.front().equivalent_diameter;
+    for (const auto& s : scene.spheres) marker_radius_ = std::max(marker_radius_, s.radius);
+  }
+
+  std::string trackingCamera() const override { return tracking_ ? e_.track_camera : std::string(); }
+  void cameraFrame(std::uint64_t frame, double time, const cv::Mat& raw) override {
+    if (tracking_ && !markers_.empty()) tracking_->addFrame(frame, time, raw);  // red exists once markers are chosen
+  }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     if (phase_ == Phase::Start) {
@@ -96,6 +109,7 @@ class ChuteExperiment final : public Experiment {
   }
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override;
+  nlohmann::json reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir, std::ostream& log) const;
 
   std::unordered_set<std::uint64_t> markerBodies() const override {
     std::unordered_set<std::uint64_t> ids;
@@ -159,6 +173,8 @@ class ChuteExperiment final : public Experiment {
       std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
       y = r.empty() ? 0.0 : r[r.size() / 2];
     }
+    // The lab knows where its markers sit (against the wall) and how big they are.
+    if (tracking_) tracking_->setMarkers(y, marker_radius_);
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
       // Heights in metres, or as fractions of the channel height at the column
@@ -288,9 +304,86 @@ class ChuteExperiment final : public Experiment {
   double discharged_mass_ = 0;
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
+  std::unique_ptr<MarkerTracking> tracking_;
+  double marker_radius_ = 0.0;  // m
   bool has_top_ = false;
   Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
 };
+
+/// The tracked velocities (images only) beside the truth: each truth marker takes
+/// the track that started nearest to it (x-z, within 3 marker radii, each track once) —
+/// the comparison reads both, the tracker never did. Adds tracked_velocity_mps
+/// to `markers`, writes tracks.csv and tracked_vs_truth.png; returns the summary.
+nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir,
+                                               std::ostream& log) const {
+  if (!tracking_ || markers_.empty()) return nullptr;
+  const MarkerTracking::Result t = tracking_->finish();
+  track::writeTracksCsv(out_dir / "tracks.csv", t.tracks, tracking_->camera(), tracking_->planePoint(), Vec3::UnitY());
+  std::vector<bool> used(t.tracks.size(), false);
+  double sum2 = 0, sum2_rel = 0, max_abs = 0, max_rel = 0;
+  int compared = 0, tracked = 0;
+  PlotSeries points{"markers", {}, {}, PlotSeries::Style::Points};
+  for (std::size_t k = 0; k < markers_.size(); ++k) {
+    const Marker& m = markers_[k];
+    int best = -1;
+    double best_d = 3.0 * marker_radius_;  // m: a blob centroid may sit a radius off
+    for (std::size_t j = 0; j < t.velocities.size(); ++j) {
+      if (used[j]) continue;
+      const Vec3 d = t.velocities[j].start_world - m.start;
+      const double dist = std::hypot(d.x(), d.z());
+      if (dist < best_d) {
+        best_d = dist;
+        best = static_cast<int>(j);
+      }
+    }
+    nlohmann::json& out = markers[k];
+    out["track_id"] = best >= 0 ? nlohmann::json(t.tracks[static_cast<std::size_t>(best)].id) : nlohmann::json(nullptr);
+    const double v = best >= 0 ? t.velocities[static_cast<std::size_t>(best)].velocity : std::numeric_limits<double>::quiet_NaN();
+    if (best >= 0) used[static_cast<std::size_t>(best)] = true;
+    out["tracked_velocity_mps"] = orNull(v);
+    if (std::isfinite(v)) ++tracked;
+    if (std::isfinite(v) && std::isfinite(m.velocity)) {
+      const double err = v - m.velocity;
+      sum2 += err * err;
+      sum2_rel += (err / m.velocity) * (err / m.velocity);
+      max_abs = std::max(max_abs, std::abs(err));
+      max_rel = std::max(max_rel, std::abs(err / m.velocity));
+      ++compared;
+      points.x.push_back(m.velocity);
+      points.y.push_back(v);
+    }
+  }
+  nlohmann::json s = {{"camera", e_.track_camera},
+                      {"frames", t.frames},
+                      {"tracks", t.tracks.size()},
+                      {"markers_tracked", tracked},
+                      {"markers_compared", compared},
+                      {"tracking_s", t.seconds},
+                      {"frames_per_s", t.seconds > 0 ? static_cast<double>(t.frames) / t.seconds : 0.0},
+                      {"method", "HSV red segmentation, redness-weighted centroids, Hungarian linking with constant-velocity "
+                                 "prediction; pixel -> world on the plane of the marker centres; velocity from 2 mm to "
+                                 "measure_distance of travel along the base, as the truth"}};
+  if (compared > 0) {
+    s["rms_error_mps"] = std::sqrt(sum2 / compared);
+    s["max_error_mps"] = max_abs;
+    s["rms_error_pct"] = 100.0 * std::sqrt(sum2_rel / compared);
+    s["max_error_pct"] = 100.0 * max_rel;
+    PlotSpec plot;
+    plot.title = "tracked (images only) against DEM truth, marker velocity over 100 mm";
+    plot.x_label = "truth velocity (m/s)";
+    plot.y_label = "tracked velocity (m/s)";
+    double lo = *std::min_element(points.x.begin(), points.x.end()), hi = *std::max_element(points.x.begin(), points.x.end());
+    plot.series = {points, PlotSeries{"tracked = truth", {lo, hi}, {lo, hi}, PlotSeries::Style::Line}};
+    writePlot(plot, out_dir / "tracked_vs_truth.png");
+    log << std::defaultfloat << std::setprecision(3) << "tracking: " << tracked << " of " << markers_.size()
+        << " markers tracked over " << e_.measure_distance * 1e3 << " mm in " << t.frames
+        << " frames; error against truth: RMS " << s["rms_error_mps"].get<double>() << " m/s ("
+        << s["rms_error_pct"].get<double>() << " %), max " << max_abs << " m/s (" << 100.0 * max_rel << " %)\n";
+  } else {
+    log << "tracking: no marker was tracked over the whole " << e_.measure_distance * 1e3 << " mm\n";
+  }
+  return s;
+}
 
 void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) {
   const bool flowed = std::isfinite(gate_time_);
@@ -307,20 +400,38 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                        {"travel_time_s", orNull(m.travel_time)},
                        {"truth_velocity_mps", orNull(m.velocity)},
                        {"velocity_from_gate_mps", orNull(m.velocity_from_gate)}});
+  const nlohmann::json tracking = reportTracking(markers, out_dir, log);
   r["markers"] = markers;
+  if (!tracking.is_null()) r["tracking"] = tracking;
+  // Column profile: the mean truth velocity, and the mean tracked one when tracked.
   nlohmann::json profile = nlohmann::json::array();
+  std::ofstream profile_csv(out_dir / "profile.csv");
+  profile_csv << "column,distance_m,mean_truth_velocity_mps,mean_tracked_velocity_mps\n";
   for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
-    double sum = 0;
-    int n = 0;
-    for (const Marker& m : markers_)
-      if (m.column == static_cast<int>(c) + 1 && std::isfinite(m.velocity)) {
-        sum += m.velocity;
+    double sum = 0, sum_tracked = 0;
+    int n = 0, n_tracked = 0;
+    for (std::size_t k = 0; k < markers_.size(); ++k) {
+      if (markers_[k].column != static_cast<int>(c) + 1) continue;
+      if (std::isfinite(markers_[k].velocity)) {
+        sum += markers_[k].velocity;
         ++n;
       }
+      const nlohmann::json& tv = markers[k].value("tracked_velocity_mps", nlohmann::json(nullptr));
+      if (tv.is_number()) {
+        sum_tracked += tv.get<double>();
+        ++n_tracked;
+      }
+    }
+    const nlohmann::json truth = n ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
+    const nlohmann::json tracked = n_tracked ? nlohmann::json(sum_tracked / n_tracked) : nlohmann::json(nullptr);
     profile.push_back({{"column", c + 1},
                        {"distance_m", e_.marker_columns[c]},
-                       {"mean_truth_velocity_mps", n ? nlohmann::json(sum / n) : nlohmann::json(nullptr)},
-                       {"markers_measured", n}});
+                       {"mean_truth_velocity_mps", truth},
+                       {"markers_measured", n},
+                       {"mean_tracked_velocity_mps", tracked},
+                       {"markers_tracked", n_tracked}});
+    profile_csv << c + 1 << ',' << e_.marker_columns[c] << ',' << (n ? std::to_string(sum / n) : "") << ','
+                << (n_tracked ? std::to_string(sum_tracked / n_tracked) : "") << '\n';
   }
   r["profile"] = profile;
   r["chute"] = {{"inclination_deg", e_.inclination_deg},
@@ -372,6 +483,23 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
       prof.series.push_back(s);
     }
     writePlot(prof, out_dir / "velocity_profile.png");
+    // The column profile: DEM truth and, when the camera's frames were tracked, the tracker's.
+    PlotSpec columns;
+    columns.title = "column profile: mean marker velocity over 100 mm";
+    columns.x_label = "column distance from the gate (mm)";
+    columns.y_label = "mean velocity (m/s)";
+    PlotSeries truth{"DEM truth", {}, {}, PlotSeries::Style::LinePoints};
+    PlotSeries tracked{"tracked in the frames", {}, {}, PlotSeries::Style::LinePoints};
+    for (const auto& c : r["profile"]) {
+      const double x = c["distance_m"].get<double>() * 1e3;
+      truth.x.push_back(x);
+      truth.y.push_back(c["mean_truth_velocity_mps"].is_number() ? c["mean_truth_velocity_mps"].get<double>() : NAN);
+      tracked.x.push_back(x);
+      tracked.y.push_back(c["mean_tracked_velocity_mps"].is_number() ? c["mean_tracked_velocity_mps"].get<double>() : NAN);
+    }
+    columns.series = {truth};
+    if (tracking_) columns.series.push_back(tracked);
+    writePlot(columns, out_dir / "profile.png");
     PlotSpec dis;
     dis.title = "discharged mass after the gate opened";
     dis.x_label = "time after gate opening (s)";

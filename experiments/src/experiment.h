@@ -11,6 +11,7 @@
 #include <iosfwd>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -36,6 +37,9 @@ class Experiment {
   virtual bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) = 0;
   /// Ids of the marker bodies (drawn red by the cameras).
   virtual std::unordered_set<std::uint64_t> markerBodies() const { return {}; }
+  /// Name of the camera whose raw frames the experiment wants (tracking), "" = none.
+  virtual std::string trackingCamera() const { return {}; }
+  virtual void cameraFrame(std::uint64_t /*frame*/, double /*time*/, const cv::Mat& /*raw*/) {}
   /// A few words for the progress line, e.g. "phase flow, 812 bodies left".
   virtual std::string progress() const { return {}; }
   /// Adds the figures to results.json and writes the experiment's CSV and PNG files.

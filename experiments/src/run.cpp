@@ -194,6 +194,12 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     log << "error: camera: " << e.what() << "\n";
     return kExitBadInput;
   }
+  if (experiment && !experiment->trackingCamera().empty())
+    for (auto& c : cameras)
+      if (c->settings().name == experiment->trackingCamera())
+        c->on_frame = [&experiment](std::uint64_t frame, double time, const cv::Mat& raw) {
+          experiment->cameraFrame(frame, time, raw);
+        };
   std::unique_ptr<out::RunFile> run_file;
   std::unique_ptr<out::VtkSeries> vtk;
   if (scene.run.hdf5) run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene_text);

@@ -436,7 +436,8 @@ std::vector<std::string> wallNames(const sim::Model& model) {
   return names;
 }
 
-void readExperiment(TableReader& root, const sim::Model& model, ExperimentSettings& e) {
+void readExperiment(TableReader& root, const sim::Model& model, const std::vector<CameraSettings>& cameras,
+                    ExperimentSettings& e) {
   auto t = root.table("experiment");
   if (!t) return;
   e.type = t->requiredString("type", {"drop", "heap", "chute"});
@@ -475,6 +476,11 @@ void readExperiment(TableReader& root, const sim::Model& model, ExperimentSettin
     e.measure_distance = t->number("measure_distance", e.measure_distance, positive);
     e.remove_beyond = t->number("remove_beyond", e.remove_beyond, positive);
     e.jam_time = t->number("jam_time", e.jam_time, positive);
+    e.track = t->boolean("track", e.track);
+    std::vector<std::string> camera_names;
+    for (const auto& c : cameras) camera_names.push_back(c.name);
+    e.track_camera = t->string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
+    if (!e.track) e.track_camera.clear();
   }
   t->finish();
 }
@@ -571,8 +577,8 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   readWalls(root, materials, base_dir, model, scene.wall_looks);
   readParticles(root, materials, model.materials, scene.run.seed, base_dir, scene);
 
-  readExperiment(root, model, scene.experiment);
   readCameras(root, scene.cameras);
+  readExperiment(root, model, scene.cameras, scene.experiment);
 
   // [output]
   if (auto t = root.table("output")) {

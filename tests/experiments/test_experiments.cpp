@@ -133,6 +133,13 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   CHECK(r["cameras"][0]["frames"].get<int>() > 50);
   CHECK(fs::exists(dir / r["cameras"][0]["movie"].get<std::string>()));
   CHECK(r["cameras"][0]["gl_renderer"].get<std::string>().size() > 0);
+  // The tracker (images only) against the truth: every marker it followed over
+  // the 100 mm window within 3 % (issue 6), most markers followed.
+  REQUIRE(r.contains("tracking"));
+  CHECK(r["tracking"]["markers_compared"].get<int>() >= 6);
+  CHECK(r["tracking"]["max_error_pct"].get<double>() < 3.0);
+  CHECK(fs::exists(dir / "tracks.csv"));
+  CHECK(fs::exists(dir / "profile.png"));
 }
 
 TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[experiment]") {

@@ -67,6 +67,8 @@ struct ExperimentSettings {
   double measure_distance = 0.1;       // m of travel over which a marker's mean velocity is taken
   double remove_beyond = 0.1;          // m past the outlet where discharged bodies are deleted
   double jam_time = 1.0;               // s without any discharge (bodies left) = jammed
+  std::string track_camera;            // camera whose frames are tracked ("" = the first camera, if any)
+  bool track = true;                   // track the markers in that camera's frames
 };
 
 /// Mass properties of one clump shape of the scene, for the log and results.json.

@@ -1,0 +1,48 @@
+#pragma once
+// Lab-style tracking of the red markers in one camera's raw frames: the
+// tracker (rocklab_track) sees only the images and the camera calibration,
+// never the simulation. Velocities are taken like the DEM truth: along the base
+// (-x), from 2 mm of travel to measure_distance, on the plane of the marker
+// centres (y = marker plane, one marker radius behind the camera-side wall).
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "rocklab/geometry/camera.h"
+#include "rocklab/track/detect.h"
+#include "rocklab/track/link.h"
+#include "rocklab/track/velocity.h"
+
+namespace rocklab::experiments {
+
+class MarkerTracking {
+ public:
+  MarkerTracking(const geometry::Camera& camera, double measure_distance);
+  /// Where the markers sit (y of their centres: against the camera-side wall) and
+  /// their equivalent radius, as the lab knows its painted pebbles: gives the
+  /// expected blob area, so that touching markers are split into two.
+  void setMarkers(double plane_y, double radius);
+  void addFrame(std::uint64_t frame, double time, const cv::Mat& bgr);
+
+  struct Result {
+    std::vector<track::Track> tracks;
+    std::vector<track::MarkerVelocity> velocities;  // one per track
+    std::uint64_t frames = 0;
+    double seconds = 0.0;  // wall time of detection and linking
+  };
+  Result finish() const;
+  const geometry::Camera& camera() const { return camera_; }
+  geometry::Vec3 planePoint() const { return {0.0, plane_y_, 0.0}; }
+
+ private:
+  geometry::Camera camera_;
+  double measure_distance_;
+  double plane_y_ = 0.0;
+  track::DetectorSettings detector_;
+  track::Linker linker_;
+  std::uint64_t frames_ = 0;
+  double seconds_ = 0.0;
+};
+
+}  // namespace rocklab::experiments

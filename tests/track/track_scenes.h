@@ -1,0 +1,113 @@
+#pragma once
+// Synthetic frames and rendered scenes shared by the track tests and the track benchmark.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "rocklab/geometry/camera.h"
+#include "rocklab/geometry/packing.h"
+#include "rocklab/render/frame.h"
+
+namespace rocklab::track::test {
+
+using geometry::Camera;
+using geometry::Vec2;
+using geometry::Vec3;
+
+inline constexpr double kFrameRate = 500.0;  // frames/s, the lab camera
+inline const cv::Scalar kPaintedRed(40, 35, 190);  // BGR of a red marker in a photo
+
+/// A grey frame (level 120, Gaussian sensor noise of `noise` grey levels, seeded).
+inline cv::Mat greyFrame(cv::Size size, double noise, std::uint64_t seed) {
+  cv::Mat frame(size, CV_8UC3, cv::Scalar(120, 120, 120));
+  if (noise > 0) {
+    cv::Mat n(size, CV_16SC3);
+    cv::RNG rng(seed);
+    rng.fill(n, cv::RNG::NORMAL, 0.0, noise);
+    cv::Mat wide;
+    frame.convertTo(wide, CV_16SC3);
+    wide += n;
+    wide.convertTo(frame, CV_8UC3);  // saturating
+  }
+  return frame;
+}
+
+/// An antialiased filled disc centred at sub-pixel `centre` (pixel (0, 0) = centre
+/// of the top-left pixel, as in geometry::Camera), 1/256 px resolution.
+inline void drawDisc(cv::Mat& frame, cv::Point2d centre, double radius, const cv::Scalar& colour = kPaintedRed) {
+  constexpr int shift = 8;
+  const double scale = 1 << shift;
+  cv::circle(frame, cv::Point(static_cast<int>(std::lround(centre.x * scale)), static_cast<int>(std::lround(centre.y * scale))),
+             static_cast<int>(std::lround(radius * scale)), colour, cv::FILLED, cv::LINE_AA, shift);
+}
+
+/// The lab-like camera of the tests: 640×480, fx 800, fy 805, off-centre principal
+/// point, barrel distortion, looking down at about 38° on the chute base (z = 0)
+/// from the camera side (−y).
+inline Camera obliqueCamera(double k1 = -0.1, double k2 = 0.0) {
+  Camera c;
+  c.fx = 800.0;
+  c.fy = 805.0;
+  c.cx = 322.3;
+  c.cy = 236.8;
+  c.k1 = k1;
+  c.k2 = k2;
+  c.frameRate = kFrameRate;
+  c.lookAt(Vec3(0.05, -0.45, 0.35), Vec3(0.0, 0.0, 0.0), Vec3(0, 0, 1));
+  return c;
+}
+
+/// A flat checkerboard on z = 0: inner_cols × inner_rows inner corners, squares of
+/// `square` m, the first inner corner at the origin, x along the columns, y along
+/// the rows; a white border one square wide around it. Squares and border are
+/// separate coplanar polygons that never overlap (no depth fighting).
+inline render::FrameDescription checkerboard(int inner_cols, int inner_rows, double square) {
+  render::FrameDescription f;
+  const render::Rgb black{0.04f, 0.04f, 0.04f}, white{0.92f, 0.92f, 0.92f};
+  auto quad = [&](double x0, double y0, double x1, double y1, render::Rgb colour) {
+    f.polygons.push_back({{Vec3(x0, y0, 0), Vec3(x1, y0, 0), Vec3(x1, y1, 0), Vec3(x0, y1, 0)}, colour, 1.0f});
+  };
+  const double x0 = -square, y0 = -square;  // outer corner of the squares
+  const double x1 = x0 + (inner_cols + 1) * square, y1 = y0 + (inner_rows + 1) * square;
+  for (int i = 0; i <= inner_rows; ++i)
+    for (int j = 0; j <= inner_cols; ++j)
+      quad(x0 + j * square, y0 + i * square, x0 + (j + 1) * square, y0 + (i + 1) * square, (i + j) % 2 ? white : black);
+  const double m = square;  // border width
+  quad(x0 - m, y0 - m, x1 + m, y0, white);
+  quad(x0 - m, y1, x1 + m, y1 + m, white);
+  quad(x0 - m, y0, x0, y1, white);
+  quad(x1, y0, x1 + m, y1, white);
+  return f;
+}
+
+/// The benchmark scene: 7,000 non-overlapping grey pebbles (radius 3–7 mm) in a
+/// 0.5 × 0.16 × 0.3 m box on a floor, against a back wall and behind a Perspex wall
+/// (the render benchmark's chute seen from the side); the 20 pebbles nearest the
+/// Perspex (smallest y) are red markers, shifted by `shift` (m) along −x.
+inline render::FrameDescription benchmarkScene(double shift = 0.0) {
+  geometry::Rng rng(42);
+  std::vector<double> radii(7000);
+  for (double& r : radii) r = rng.uniform(0.003, 0.007);
+  const auto centres = geometry::randomNonOverlapping(radii, Vec3(-0.25, -0.08, 0.0), Vec3(0.25, 0.08, 0.3), {}, rng);
+  std::vector<std::size_t> order(centres.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::partial_sort(order.begin(), order.begin() + 20, order.end(),
+                    [&](std::size_t a, std::size_t b) { return centres[a].y() - radii[a] < centres[b].y() - radii[b]; });
+  render::FrameDescription f;
+  for (std::size_t i = 0; i < centres.size(); ++i) f.spheres.push_back({centres[i], radii[i], render::kGreyPebble, Vec3::Zero()});
+  for (int k = 0; k < 20; ++k) {
+    render::SphereInstance& s = f.spheres[order[k]];
+    s.colour = render::kRedMarker;
+    s.centre.x() -= shift;
+  }
+  f.polygons.push_back({{{-0.4, -0.1, 0}, {0.4, -0.1, 0}, {0.4, 0.1, 0}, {-0.4, 0.1, 0}}, {0.4f, 0.38f, 0.35f}, 1.0f});
+  f.polygons.push_back({{{-0.4, 0.09, 0}, {0.4, 0.09, 0}, {0.4, 0.09, 0.35}, {-0.4, 0.09, 0.35}}, {0.3f, 0.32f, 0.36f}, 1.0f});
+  f.polygons.push_back({{{-0.4, -0.09, 0}, {0.4, -0.09, 0}, {0.4, -0.09, 0.35}, {-0.4, -0.09, 0.35}}, render::kPerspex, 0.15f});
+  return f;
+}
+
+}  // namespace rocklab::track::test

@@ -1,0 +1,68 @@
+#pragma once
+// Red marker detection in one colour frame (BGR, 8 bits per channel).
+//
+// The pipeline, in order (src/detect.cpp):
+//   1. segment    — HSV thresholds, two hue bands around red (OpenCV's 8-bit hue
+//                   runs 0..179, red wraps at 0/180), then a morphological open
+//                   (a square of open_kernel_px) that removes specks and threads;
+//   2. components — 8-connected components with their pixel counts;
+//   3. reference  — the area of one marker: expected_area_px, or (0) the median
+//                   area of this frame's components;
+//   4. split      — a component larger than split_ratio × reference and less round
+//                   than split_max_fill (one disc fills ~0.9 of its enclosing circle,
+//                   two touching discs 0.5, three or four in a clump 0.65–0.7) is
+//                   touching markers: k = round(area / reference) pieces, seeded at the k
+//                   highest distance-transform peaks (each peak suppresses a disc
+//                   of one marker radius), refined by k-means (Lloyd) on the
+//                   pixel coordinates; a pixel belongs to the nearest piece centre,
+//                   so two equal touching discs are cut along their bisector;
+//   5. measure    — centroid weighted by the redness w = max(0, r − max(g, b)) over
+//                   the piece and a one-pixel rim around it (the antialiased edge
+//                   that missed the thresholds), so it is sub-pixel;
+//   6. filter     — area within [min_area_px, max_area_px], fill ≥ min_fill.
+// Pixel coordinates follow geometry::Camera: (0, 0) is the centre of the top-left pixel.
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace rocklab::track {
+
+struct Detection {
+  cv::Point2d centroid;  // px, redness-weighted, sub-pixel
+  double area_px = 0;    // px², pixels of the (opened) mask in this marker
+  double radius_px = 0;  // px, equivalent radius √(area / π)
+  double fill = 0;       // area / area of the smallest enclosing circle [-]: 1 for a disc, ½ for two touching discs
+};
+
+struct DetectorSettings {
+  // HSV thresholds (OpenCV 8-bit scale: hue 0..179, saturation and value 0..255).
+  // Red is hue ≤ hue_low_max or hue ≥ hue_high_min.
+  int hue_low_max = 10;
+  int hue_high_min = 170;
+  int saturation_min = 100;  // grey pebbles sit near 10, the painted markers above 200
+  int value_min = 40;        // the shaded side of a marker still counts
+  // Morphological open, square kernel side [px]; 0 or 1 = off.
+  int open_kernel_px = 3;
+  // Accepted marker size [px²], applied to each piece after splitting.
+  double min_area_px = 12.0;
+  double max_area_px = 20000.0;
+  // Smallest accepted fill (area / enclosing-circle area) [-]: rejects slivers and threads.
+  double min_fill = 0.35;
+  // A component larger than split_ratio × the reference area and with a fill below
+  // split_max_fill is split [-]; a big round blob is one big marker.
+  double split_ratio = 1.8;
+  double split_max_fill = 0.8;
+  // Area of one marker [px²]; 0 = the median component area of each frame (needs
+  // a frame with mostly single markers; with one component nothing is ever split).
+  double expected_area_px = 0.0;
+
+  /// Throws std::invalid_argument naming the first invalid field ("detector.min_fill ...").
+  void validate() const;
+};
+
+/// Red markers in a BGR image (CV_8UC3). Settings are validated; an image of
+/// another type throws std::invalid_argument. No marker → an empty list.
+/// Detections are in row-major order of their components (top to bottom).
+std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings = {});
+
+}  // namespace rocklab::track

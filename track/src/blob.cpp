@@ -1,0 +1,80 @@
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detect_internal.h"
+
+namespace rocklab::track::detail {
+
+namespace {
+
+// Redness of a BGR pixel: r − max(g, b), ≥ 0. Grey (and its white specular
+// highlight added to red) contributes nothing extra; the antialiased edge of a
+// marker counts in proportion to its coverage.
+double redness(const cv::Vec3b& p) { return std::max(0, int(p[2]) - std::max(int(p[0]), int(p[1]))); }
+
+}  // namespace
+
+Blob componentBlob(const cv::Mat& labels, int label, const cv::Rect& box) {
+  Blob blob;
+  blob.core.reserve(static_cast<std::size_t>(box.area()));
+  // The box grown by one pixel (clipped to the image) holds the core and its rim.
+  const int u0 = std::max(0, box.x - 1), u1 = std::min(labels.cols - 1, box.x + box.width);
+  const int v0 = std::max(0, box.y - 1), v1 = std::min(labels.rows - 1, box.y + box.height);
+  for (int v = v0; v <= v1; ++v) {
+    const int* row = labels.ptr<int>(v);
+    for (int u = u0; u <= u1; ++u) {
+      if (row[u] == label) {
+        blob.core.emplace_back(u, v);
+        continue;
+      }
+      if (row[u] != 0) continue;  // another component's pixel is never our rim
+      bool touches = false;
+      for (int dv = -1; dv <= 1 && !touches; ++dv) {
+        const int vv = v + dv;
+        if (vv < 0 || vv >= labels.rows) continue;
+        const int* r = labels.ptr<int>(vv);
+        for (int du = -1; du <= 1; ++du) {
+          const int uu = u + du;
+          if (uu >= 0 && uu < labels.cols && r[uu] == label) {
+            touches = true;
+            break;
+          }
+        }
+      }
+      if (touches) blob.rim.emplace_back(u, v);
+    }
+  }
+  return blob;
+}
+
+Detection measureBlob(const cv::Mat& bgr, const Blob& blob) {
+  Detection d;
+  // Redness-weighted centroid over core and rim; the plain mean if nothing is red.
+  double su = 0, sv = 0, sw = 0;
+  for (const auto* pixels : {&blob.core, &blob.rim})
+    for (const cv::Point& p : *pixels) {
+      const double w = redness(bgr.at<cv::Vec3b>(p));
+      su += w * p.x, sv += w * p.y, sw += w;
+    }
+  if (sw > 0) {
+    d.centroid = cv::Point2d(su / sw, sv / sw);
+  } else {
+    for (const cv::Point& p : blob.core) su += p.x, sv += p.y;
+    d.centroid = cv::Point2d(su / blob.core.size(), sv / blob.core.size());
+  }
+  d.area_px = static_cast<double>(blob.core.size());
+  d.radius_px = std::sqrt(d.area_px / std::numbers::pi);
+  // Fill: the enclosing circle of the pixel centres grown by half a pixel covers
+  // the pixel squares (up to the corners); capped at 1 for tiny blobs.
+  cv::Point2f centre;
+  float radius = 0;
+  cv::minEnclosingCircle(blob.core, centre, radius);
+  const double enclosing = std::numbers::pi * (radius + 0.5) * (radius + 0.5);
+  d.fill = std::min(1.0, d.area_px / enclosing);
+  return d;
+}
+
+}  // namespace rocklab::track::detail

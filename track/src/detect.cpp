@@ -1,0 +1,97 @@
+#include "rocklab/track/detect.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "detect_internal.h"
+
+namespace rocklab::track {
+
+namespace {
+
+[[noreturn]] void invalid(const std::string& field, const std::string& what, double got) {
+  std::ostringstream s;
+  s << "detector." << field << ' ' << what << " (got " << got << ')';
+  throw std::invalid_argument(s.str());
+}
+
+}  // namespace
+
+void DetectorSettings::validate() const {
+  if (hue_low_max < 0 || hue_low_max > 179) invalid("hue_low_max", "must be in [0, 179]", hue_low_max);
+  if (hue_high_min < 0 || hue_high_min > 179) invalid("hue_high_min", "must be in [0, 179]", hue_high_min);
+  if (saturation_min < 0 || saturation_min > 255) invalid("saturation_min", "must be in [0, 255]", saturation_min);
+  if (value_min < 0 || value_min > 255) invalid("value_min", "must be in [0, 255]", value_min);
+  if (open_kernel_px < 0 || open_kernel_px > 31) invalid("open_kernel_px", "must be in [0, 31] px", open_kernel_px);
+  if (!(min_area_px >= 1.0)) invalid("min_area_px", "must be >= 1 px", min_area_px);
+  if (!(max_area_px >= min_area_px)) invalid("max_area_px", "must be >= min_area_px", max_area_px);
+  if (!(min_fill >= 0.0 && min_fill <= 1.0)) invalid("min_fill", "must be in [0, 1]", min_fill);
+  if (!(split_ratio > 1.0) || !std::isfinite(split_ratio)) invalid("split_ratio", "must be a finite ratio > 1", split_ratio);
+  if (!(split_max_fill >= 0.0 && split_max_fill <= 1.0)) invalid("split_max_fill", "must be in [0, 1]", split_max_fill);
+  if (!(expected_area_px >= 0.0) || !std::isfinite(expected_area_px))
+    invalid("expected_area_px", "must be >= 0 px (0 = median of the frame)", expected_area_px);
+}
+
+std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings) {
+  settings.validate();
+  if (bgr.empty() || bgr.type() != CV_8UC3)
+    throw std::invalid_argument("detectMarkers: the image must be 8-bit BGR (CV_8UC3) and not empty");
+
+  // 1. segment.
+  const cv::Mat mask = detail::redMask(bgr, settings);
+
+  // 2. components (label 0 is the background).
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<int> candidates;
+  std::vector<double> areas;
+  for (int label = 1; label < count; ++label) {
+    const double area = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (area < settings.min_area_px) continue;
+    candidates.push_back(label);
+    areas.push_back(area);
+  }
+  if (candidates.empty()) return {};
+
+  // 3. reference area of one marker.
+  double reference = settings.expected_area_px;
+  if (reference == 0.0) {
+    std::vector<double> sorted = areas;
+    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+    std::nth_element(sorted.begin(), middle, sorted.end());
+    reference = *middle;
+  }
+
+  std::vector<Detection> out;
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const int label = candidates[c];
+    const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+                       stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    const detail::Blob blob = detail::componentBlob(labels, label, box);
+    // 5. measure the whole component; 4. split it if it is touching markers
+    // (large and not round), measuring each piece; 6. filter.
+    std::vector<Detection> found{detail::measureBlob(bgr, blob)};
+    if (areas[c] > settings.split_ratio * reference && found[0].fill < settings.split_max_fill) {
+      const int k = std::max(2, static_cast<int>(std::lround(areas[c] / reference)));
+      const std::vector<detail::Blob> pieces = detail::splitBlob(blob, k, std::sqrt(reference / std::numbers::pi));
+      if (pieces.size() > 1) {
+        found.clear();
+        for (const detail::Blob& piece : pieces) found.push_back(detail::measureBlob(bgr, piece));
+      }
+    }
+    for (const Detection& d : found) {
+      if (d.area_px < settings.min_area_px || d.area_px > settings.max_area_px) continue;
+      if (d.fill < settings.min_fill) continue;
+      out.push_back(d);
+    }
+  }
+  return out;
+}
+
+}  // namespace rocklab::track

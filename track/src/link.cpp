@@ -1,0 +1,112 @@
+#include "rocklab/track/link.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "rocklab/track/assignment.h"
+
+namespace rocklab::track {
+
+namespace {
+
+// Constant-velocity prediction of a track's pixel at `time`.
+cv::Point2d predict(const Track& track, double time) {
+  const TrackPoint& last = track.points.back();
+  if (track.points.size() < 2) return last.pixel;
+  const TrackPoint& prev = track.points[track.points.size() - 2];
+  const cv::Point2d velocity = (last.pixel - prev.pixel) / (last.time - prev.time);  // px/s
+  return last.pixel + velocity * (time - last.time);
+}
+
+double squaredDistance(const cv::Point2d& a, const cv::Point2d& b) {
+  const cv::Point2d d = a - b;
+  return d.dot(d);
+}
+
+}  // namespace
+
+void LinkSettings::validate() const {
+  if (!(max_distance_px > 0.0) || !std::isfinite(max_distance_px)) {
+    std::ostringstream s;
+    s << "link.max_distance_px must be a finite distance > 0 px (got " << max_distance_px << ')';
+    throw std::invalid_argument(s.str());
+  }
+  if (max_missed_frames < 0)
+    throw std::invalid_argument("link.max_missed_frames must be >= 0 (got " + std::to_string(max_missed_frames) + ")");
+}
+
+Linker::Linker(LinkSettings settings) : settings_(settings) { settings_.validate(); }
+
+void Linker::add(int frame, double time, const std::vector<Detection>& detections) {
+  if (started_ && !(frame > last_frame_ && time > last_time_)) {
+    std::ostringstream s;
+    s << "Linker::add: frames and times must increase (frame " << frame << " at " << time << " s after frame "
+      << last_frame_ << " at " << last_time_ << " s)";
+    throw std::invalid_argument(s.str());
+  }
+  started_ = true;
+  last_frame_ = frame;
+  last_time_ = time;
+
+  // 1. retire tracks unseen for more than max_missed_frames frames.
+  std::erase_if(active_, [&](int id) {
+    return frame - tracks_[id].points.back().frame - 1 > settings_.max_missed_frames;
+  });
+
+  // 2. predict, 3. cost: squared distance, gated.
+  const int n = static_cast<int>(active_.size()), m = static_cast<int>(detections.size());
+  const double gate2 = settings_.max_distance_px * settings_.max_distance_px;
+  std::vector<double> distance2(static_cast<std::size_t>(n) * m);
+  for (int i = 0; i < n; ++i) {
+    const cv::Point2d p = predict(tracks_[active_[i]], time);
+    for (int j = 0; j < m; ++j) distance2[static_cast<std::size_t>(i) * m + j] = squaredDistance(p, detections[j].centroid);
+  }
+
+  // 4. assign: detection of each active track, −1 = missed this frame.
+  std::vector<int> match(n, -1);
+  if (n > 0 && m > 0) {
+    if (settings_.assignment == LinkSettings::Assignment::Greedy) {
+      match = greedyAssignment(distance2, n, m, gate2);
+    } else {
+      // Augmented (n + m) square matrix; a forbidden pair costs more than any
+      // solution without one (at most (n + m) gate²), so none is ever chosen.
+      const int size = n + m;
+      const double forbidden = 4.0 * gate2 * (size + 1);
+      std::vector<double> cost(static_cast<std::size_t>(size) * size, forbidden);
+      auto at = [&](int r, int c) -> double& { return cost[static_cast<std::size_t>(r) * size + c]; };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < m; ++j) {
+          const double d2 = distance2[static_cast<std::size_t>(i) * m + j];
+          if (d2 <= gate2) at(i, j) = d2;
+        }
+      for (int i = 0; i < n; ++i) at(i, m + i) = gate2;  // track i missed
+      for (int j = 0; j < m; ++j) at(n + j, j) = gate2;  // detection j starts a track
+      for (int r = n; r < size; ++r)
+        for (int c = m; c < size; ++c) at(r, c) = 0.0;    // dummy ↔ dummy
+      const std::vector<int> solution = solveAssignment(cost, size, size);
+      for (int i = 0; i < n; ++i)
+        if (solution[i] < m) match[i] = solution[i];
+    }
+  }
+
+  // 5. update: matched tracks grow, the other detections start tracks.
+  std::vector<char> used(m, 0);
+  for (int i = 0; i < n; ++i) {
+    if (match[i] < 0) continue;
+    tracks_[active_[i]].points.push_back({frame, time, detections[match[i]].centroid});
+    used[match[i]] = 1;
+  }
+  for (int j = 0; j < m; ++j) {
+    if (used[j]) continue;
+    const int id = static_cast<int>(tracks_.size());
+    tracks_.push_back({id, {{frame, time, detections[j].centroid}}});
+    active_.push_back(id);
+  }
+}
+
+std::vector<Track> Linker::tracks() const { return tracks_; }
+
+}  // namespace rocklab::track
