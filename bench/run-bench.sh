@@ -3,11 +3,12 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|grid|render|all] [small|full] [OUTDIR]
+# Usage: bench/run-bench.sh [settle|dense|grid|render|track|all] [small|full] [OUTDIR]
 #   scene  settle (contact-sparse), dense (contact-rich), grid (7:1 size ratio:
 #          multi-level against single-level neighbour grid, rocklab only), render
 #          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
-#          1280x1024, rocklab only) or all (default)
+#          1280x1024, rocklab only), track (marker detection + linking frames/s on
+#          the same frames) or all (default)
 #   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
 #   OUTDIR logs and results (default: a new temporary directory)
 # Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install liggghts`.
@@ -109,4 +110,11 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = render ]; then
   cmake --build "$root/build" --target render_benchmark >/dev/null
   printf '\nrender\n'
   "$root/build/tests/render_benchmark"
+fi
+
+# Tracker: detection + linking frames per second on rendered frames with 20 markers.
+if [ "$which_scenes" = all ] || [ "$which_scenes" = track ]; then
+  cmake --build "$root/build" --target track_benchmark >/dev/null
+  printf '\ntrack\n'
+  "$root/build/tests/track_benchmark"
 fi
