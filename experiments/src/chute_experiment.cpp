@@ -173,8 +173,9 @@ class ChuteExperiment final : public Experiment {
       std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
       y = r.empty() ? 0.0 : r[r.size() / 2];
     }
-    // The lab knows where its markers sit (against the wall) and how big they are.
-    if (tracking_) tracking_->setMarkers(y, marker_radius_);
+    // The lab knows how big its markers are and that they lie against the wall:
+    // their centres one (equivalent) radius behind it.
+    if (tracking_) tracking_->setMarkers(marker_radius_, marker_radius_);
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
       // Heights in metres, or as fractions of the channel height at the column
