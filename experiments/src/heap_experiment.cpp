@@ -1,10 +1,15 @@
 // Heap test (experiments.md §b): the poured pebbles come to rest on the table;
 // the angle of repose is measured from the final positions (heap_analysis.h).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <ostream>
 
 #include "experiment.h"
 #include "heap_analysis.h"
 #include "plot.h"
+#include "rocklab/render/image_io.h"
+#include "rocklab/track/plane.h"
 
 namespace rocklab::experiments {
 
@@ -12,7 +17,16 @@ namespace {
 
 class HeapExperiment final : public Experiment {
  public:
-  explicit HeapExperiment(const Scene& scene) : e_(scene.experiment) {}
+  explicit HeapExperiment(const Scene& scene) : e_(scene.experiment) {
+    if (!scene.cameras.empty()) {
+      camera_name_ = scene.cameras.front().name;
+      camera_ = scene.cameras.front().camera;
+    }
+  }
+
+  // The photograph: the camera's last raw frame before the heap is measured.
+  std::string trackingCamera() const override { return balls_.empty() ? camera_name_ : std::string(); }
+  void cameraFrame(std::uint64_t, double, const cv::Mat& raw) override { photo_ = raw.clone(); }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext&) override {
     const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
@@ -63,6 +77,7 @@ class HeapExperiment final : public Experiment {
       h["note"] = std::string("no heap to measure: ") + ex.what();
       log << "heap: no angle: " << ex.what() << "\n";
     }
+    if (!photo_.empty()) h["photograph"] = measurePhoto(out_dir, r["angle_of_repose_deg"], log);
     r["heap"] = h;
     writeProfilePlot(out_dir / "heap_profile.png");
   }
@@ -88,7 +103,74 @@ class HeapExperiment final : public Experiment {
     writePlot(spec, png);
   }
 
+  /// The angle as a lab reads it off a side photograph: pebble pixels (brighter
+  /// than the dark table and backdrop), the top of the pile in every pixel column,
+  /// pixels mapped onto the vertical plane through the heap axis, and a line fit
+  /// on each flank between 20 % and 80 % of the height.
+  nlohmann::json measurePhoto(const std::filesystem::path& out_dir, const nlohmann::json& geometric,
+                              std::ostream& log) const {
+    render::writePng(out_dir / "heap_side.png", photo_);
+    double cx = 0, cy = 0;
+    for (const auto& b : balls_) {
+      cx += b.centre.x() / static_cast<double>(balls_.size());
+      cy += b.centre.y() / static_cast<double>(balls_.size());
+    }
+    std::vector<double> xs, zs;
+    for (int u = 0; u < photo_.cols; ++u)
+      for (int v = 2; v < photo_.rows; ++v) {
+        auto bright = [&](int row) {
+          const cv::Vec3b p = photo_.at<cv::Vec3b>(row, u);
+          return std::max({p[0], p[1], p[2]}) > 70;
+        };
+        if (!(bright(v) && bright(v - 1) && bright(v - 2))) continue;  // three in a row: not a speck
+        if (const auto w = track::pixelToPlane(camera_, cv::Point2d(u, v - 2), {cx, cy, 0.0}, {0.0, 1.0, 0.0})) {
+          if (w->z() > e_.base_z + 0.005) {
+            xs.push_back(w->x() - cx);
+            zs.push_back(w->z() - e_.base_z);
+          }
+        }
+        break;
+      }
+    nlohmann::json out;
+    if (xs.size() < 10) {
+      out["note"] = "no pile found in the photograph";
+      return out;
+    }
+    const std::size_t peak = static_cast<std::size_t>(std::max_element(zs.begin(), zs.end()) - zs.begin());
+    const double height = zs[peak];
+    std::vector<double> angles;
+    for (int side : {-1, 1}) {
+      double sx = 0, sz = 0, sxx = 0, sxz = 0;
+      int n = 0;
+      for (std::size_t k = 0; k < xs.size(); ++k) {
+        if ((xs[k] - xs[peak]) * side <= 0 || zs[k] < 0.2 * height || zs[k] > 0.8 * height) continue;
+        sx += xs[k];
+        sz += zs[k];
+        sxx += xs[k] * xs[k];
+        sxz += xs[k] * zs[k];
+        ++n;
+      }
+      const double den = n * sxx - sx * sx;
+      angles.push_back(n >= 3 && den > 0 ? std::atan(std::abs((n * sxz - sx * sz) / den)) * 180.0 / std::numbers::pi
+                                         : std::numeric_limits<double>::quiet_NaN());
+    }
+    const double mean = 0.5 * (angles[0] + angles[1]);
+    out = {{"file", "heap_side.png"},
+           {"flank_angles_deg", {angles[0], angles[1]}},
+           {"angle_deg", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
+           {"height_m", height},
+           {"method", "side photograph: top of the pile per pixel column, mapped onto the vertical plane through "
+                      "the heap axis, least-squares line per flank between 20 % and 80 % of the height"}};
+    if (std::isfinite(mean) && geometric.is_number())
+      out["difference_to_geometric_deg"] = mean - geometric.get<double>();
+    log << "heap: from the side photograph " << mean << " deg (flanks " << angles[0] << ", " << angles[1] << ")\n";
+    return out;
+  }
+
   ExperimentSettings e_;
+  std::string camera_name_;
+  geometry::Camera camera_;
+  cv::Mat photo_;
   bool settled_ = false;
   double speed_ = 0, settle_time_ = 0;
   std::vector<geometry::Sphere> balls_;

@@ -364,8 +364,10 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     }
     r["cameras"] = list;
     r["render_share_of_wall_time"] = render_s / std::max(1e-9, seconds(t_start, Clock::now()));
-    log << "rocklab: cameras rendered in " << render_s << " s (" << std::fixed << std::setprecision(1)
-        << 100.0 * r["render_share_of_wall_time"].get<double>() << " % of the wall time)" << std::defaultfloat << "\n";
+    std::ostringstream line;  // its own stream: the precision must not leak into later lines
+    line << "rocklab: cameras rendered in " << render_s << " s (" << std::fixed << std::setprecision(1)
+         << 100.0 * r["render_share_of_wall_time"].get<double>() << " % of the wall time)\n";
+    log << line.str();
   }
   if (experiment) {
     r["experiment"] = scene.experiment.type;

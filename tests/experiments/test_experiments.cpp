@@ -97,6 +97,10 @@ TEST_CASE("heap: a small heap of clumps stands at a non-zero angle", "[experimen
   CHECK(angle > 10.0);
   CHECK(angle < 40.0);
   CHECK(r["heap"]["flank_angles_deg"].size() == 4);
+  // The side photograph (rendered, measured like a lab photo) agrees with the
+  // angle from the positions within a few degrees.
+  REQUIRE(r["heap"]["photograph"]["angle_deg"].is_number());
+  CHECK(std::abs(r["heap"]["photograph"]["difference_to_geometric_deg"].get<double>()) < 4.0);
 }
 
 TEST_CASE("chute: a short clump chute discharges and reports its markers", "[experiment]") {
