@@ -2,22 +2,19 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+
+#include "rocklab/render/image_io.h"
 
 namespace rocklab::experiments {
 
 namespace {
 
-namespace fs = std::filesystem;
 
 // Okabe–Ito colour-blind-safe palette in OpenCV's BGR order; its yellow is left
 // out (unreadable on white).
@@ -230,31 +227,7 @@ void writePlot(const PlotSpec& spec, const std::filesystem::path& png) {
     }
   }
 
-  // Atomic write: encode, write "<png>.partial", rename over the target.
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("cannot write plot '" + png.string() + "': PNG encoding failed");
-  fs::path partial = png;
-  partial += ".partial";
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    if (!out)
-      throw std::runtime_error("cannot write plot '" + png.string() + "': cannot open '" + partial.string() +
-                               "': " + std::strerror(errno));
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(partial, ignored);
-      throw std::runtime_error("cannot write plot '" + png.string() + "': writing '" + partial.string() + "' failed");
-    }
-  }
-  std::error_code ec;
-  fs::rename(partial, png, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(partial, ignored);
-    throw std::runtime_error("cannot write plot '" + png.string() + "': " + ec.message());
-  }
+  render::writePng(png, img);  // atomic: "<png>.partial", then rename
 }
 
 }  // namespace rocklab::experiments
