@@ -54,7 +54,7 @@ class ChuteExperiment final : public Experiment {
  public:
   explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {
     for (const CameraSettings& c : scene.cameras)
-      if (c.name == e_.track_camera) tracking_ = std::make_unique<MarkerTracking>(c.camera, e_.measure_distance);
+      if (c.name == e_.track_camera) tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);
     // Size of a marker pebble: the clump's equivalent sphere, or the largest sphere.
     if (!scene.clump_shapes.empty()) marker_radius_ = 0.5 * scene.clump_shapes.front().equivalent_diameter;
     for (const auto& s : scene.spheres) marker_radius_ = std::max(marker_radius_, s.radius);

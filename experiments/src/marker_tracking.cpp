@@ -4,12 +4,8 @@
 
 namespace rocklab::experiments {
 
-namespace {
-constexpr double kOnset = 0.002;  // m, as the DEM truth (chute_experiment.cpp)
-}
-
-MarkerTracking::MarkerTracking(const geometry::Camera& camera, double measure_distance)
-    : camera_(camera), measure_distance_(measure_distance) {}
+MarkerTracking::MarkerTracking(const geometry::Camera& camera, double onset, double measure_distance)
+    : camera_(camera), onset_(onset), measure_distance_(measure_distance) {}
 
 void MarkerTracking::setMarkers(double plane_y, double radius) {
   plane_y_ = plane_y;
@@ -33,7 +29,7 @@ MarkerTracking::Result MarkerTracking::finish() const {
   r.tracks = linker_.tracks();
   for (const track::Track& t : r.tracks)
     r.velocities.push_back(track::trackVelocity(t, camera_, planePoint(), geometry::Vec3::UnitY(),
-                                                -geometry::Vec3::UnitX(), measure_distance_, kOnset));
+                                                -geometry::Vec3::UnitX(), measure_distance_, onset_));
   r.frames = frames_;
   r.seconds = seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

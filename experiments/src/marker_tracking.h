@@ -18,7 +18,8 @@ namespace rocklab::experiments {
 
 class MarkerTracking {
  public:
-  MarkerTracking(const geometry::Camera& camera, double measure_distance);
+  /// `onset` and `measure_distance` (m): the same as the chute's truth uses.
+  MarkerTracking(const geometry::Camera& camera, double onset, double measure_distance);
   /// Where the markers sit (y of their centres: against the camera-side wall) and
   /// their equivalent radius, as the lab knows its painted pebbles: gives the
   /// expected blob area, so that touching markers are split into two.
@@ -37,7 +38,7 @@ class MarkerTracking {
 
  private:
   geometry::Camera camera_;
-  double measure_distance_;
+  double onset_, measure_distance_;
   double plane_y_ = 0.0;
   track::DetectorSettings detector_;
   track::Linker linker_;

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "atomic_file.h"
 #include "camera_recorder.h"
 #include "experiment.h"
 #include "rocklab/sim/output/checkpoint.h"
@@ -31,17 +32,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
-}
-
-/// Writes text to path atomically (temporary file in the same folder, then rename).
-void writeAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".partial";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  std::filesystem::rename(tmp, path);
 }
 
 std::string hex(std::uint64_t v) {
@@ -374,7 +364,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     if (status == "completed" && !experiment_over) r["experiment_status"] = "time limit (scene.end_time) reached first";
     experiment->report(r, options.out_dir, log);
   }
-  writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
+  detail::writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
 
   if (!message.empty()) log << "error: " << message << "\n";
   log << "rocklab: " << status << " at t = " << world->time() << " s after " << steps_done << " steps; wall time "

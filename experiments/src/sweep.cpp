@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "atomic_file.h"
 #include "plot.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
@@ -115,15 +116,14 @@ void writeTable(const SweepOptions& o, const std::vector<std::string>& metrics, 
     row.push_back(p.code == kExitOk ? "ok" : "exit " + std::to_string(p.code));
     rows.push_back(row);
   }
-  std::ofstream csv(csv_path.string() + ".partial");
+  std::ostringstream csv;
   for (std::size_t c = 0; c < header.size(); ++c) csv << (c ? "," : "") << header[c];
   csv << "\n";
   for (const auto& row : rows) {
     for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << row[c];
     csv << "\n";
   }
-  csv.close();
-  std::filesystem::rename(csv_path.string() + ".partial", csv_path);
+  detail::writeAtomically(csv_path, csv.str());
   std::vector<std::size_t> width(header.size());
   for (std::size_t c = 0; c < header.size(); ++c) {
     width[c] = header[c].size();
@@ -336,7 +336,7 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
   json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
               {"target", c.target},      {"method", how},        {"runs", tried.size()},
               {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)}};
-  std::ofstream(dir / "calibration.json") << out.dump(2) << "\n";
+  detail::writeAtomically(dir / "calibration.json", out.dump(2) + "\n");
   if (!std::isfinite(estimate)) {
     log << "calibrate: no estimate: " << how << "; widen the values\n";
     return kExitOk;
