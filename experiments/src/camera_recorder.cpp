@@ -10,13 +10,6 @@ namespace rocklab::experiments {
 
 namespace {
 
-render::RenderOptions optionsFor(const CameraSettings& c) {
-  render::RenderOptions o;
-  o.motionBlur = c.motion_blur;
-  o.noiseSigma = c.noise_sigma;
-  return o;
-}
-
 std::string numbered(const std::string& stem, std::uint64_t k) {
   char name[64];
   std::snprintf(name, sizeof name, "_%06llu.png", static_cast<unsigned long long>(k));
@@ -25,12 +18,19 @@ std::string numbered(const std::string& stem, std::uint64_t k) {
 
 }  // namespace
 
+render::RenderOptions renderOptionsFor(const CameraSettings& c) {
+  render::RenderOptions o;
+  o.motionBlur = c.motion_blur;
+  o.noiseSigma = c.noise_sigma;
+  return o;
+}
+
 CameraRecorder::CameraRecorder(const CameraSettings& settings, const Scene& scene,
                                const std::filesystem::path& out_dir, std::ostream& log)
     : settings_(settings),
       out_dir_(out_dir),
       builder_(scene),
-      renderer_(settings.camera, optionsFor(settings)),
+      renderer_(settings.camera, renderOptionsFor(settings)),
       next_still_(settings.start_time) {
   log << "  camera '" << settings_.name << "': " << settings_.camera.width << "x" << settings_.camera.height << " at "
       << settings_.camera.frameRate << " frames/s from t = " << settings_.start_time << " s; GL "

@@ -18,6 +18,9 @@
 
 namespace rocklab::experiments {
 
+/// The render options a camera's settings ask for (motion blur, sensor noise).
+render::RenderOptions renderOptionsFor(const CameraSettings& c);
+
 class CameraRecorder {
  public:
   CameraRecorder(const CameraSettings& settings, const Scene& scene, const std::filesystem::path& out_dir,

@@ -23,6 +23,8 @@
 #include <unordered_set>
 
 #include "experiment.h"
+#include "camera_calibration.h"
+#include "camera_recorder.h"
 #include "marker_tracking.h"
 #include "plot.h"
 #include "rocklab/track/export.h"
@@ -54,7 +56,10 @@ class ChuteExperiment final : public Experiment {
  public:
   explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {
     for (const CameraSettings& c : scene.cameras)
-      if (c.name == e_.track_camera) tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);
+      if (c.name == e_.track_camera) {
+        tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);
+        track_settings_ = c;
+      }
     // Size of a marker pebble: the clump's equivalent sphere, or the largest sphere.
     if (!scene.clump_shapes.empty()) marker_radius_ = 0.5 * scene.clump_shapes.front().equivalent_diameter;
     for (const auto& s : scene.spheres) marker_radius_ = std::max(marker_radius_, s.radius);
@@ -165,17 +170,37 @@ class ChuteExperiment final : public Experiment {
     phase_ = Phase::Tilt;
   }
 
-  /// The bodies nearest the lab marker positions, each taken once (column 1 first, bottom up).
+  /// The bodies nearest the lab marker positions, each taken once (column 1 first,
+  /// bottom up). The lab paints pebbles that touch the camera-side wall (y = 0), so
+  /// by default bodies with a ball within a tenth of the median ball radius of that
+  /// wall and within three marker radii of the target in x-z come first (nearest in
+  /// x-z); otherwise, and with experiment.marker_y set, the body nearest in 3-d to
+  /// (x, marker_y or the median radius, z).
   void chooseMarkers(const sim::ParticleState& p) {
-    double y = e_.marker_y;
-    if (y <= 0) {  // one radius from the camera wall: the median ball radius
-      std::vector<double> r(p.radius);
-      std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
-      y = r.empty() ? 0.0 : r[r.size() / 2];
+    std::vector<double> r(p.radius);
+    std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+    const double median_radius = r.empty() ? 0.0 : r[r.size() / 2];
+    const bool at_wall = e_.marker_y <= 0;
+    std::unordered_map<std::uint64_t, double> wall_gap;  // body id -> smallest y - radius of its balls
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const bool member = !p.clump.empty() && p.clump[i] >= 0;
+      const std::uint64_t id = member ? p.clumps.id[static_cast<std::size_t>(p.clump[i])] : p.id[i];
+      const double gap = p.position[i].y() - p.radius[i];
+      const auto [it, fresh] = wall_gap.emplace(id, gap);
+      if (!fresh) it->second = std::min(it->second, gap);
     }
-    // The lab knows how big its markers are and that they lie against the wall:
+    // The lab calibrates its camera on the camera-side wall (y = 0, seen from -y)
+    // and knows how big its markers are and that they lie against that wall:
     // their centres one (equivalent) radius behind it.
-    if (tracking_) tracking_->setMarkers(marker_radius_, marker_radius_);
+    if (tracking_) {
+      if (e_.calibration_photos > 0) {
+        const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
+                                                    Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
+        tracking_->setCamera(cal.camera);
+        calibration_report_ = cal.report;
+      }
+      tracking_->setMarkers(marker_radius_, marker_radius_);
+    }
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
       // Heights in metres, or as fractions of the channel height at the column
@@ -187,14 +212,22 @@ class ChuteExperiment final : public Experiment {
         Marker m;
         m.column = static_cast<int>(c) + 1;
         m.row = static_cast<int>(h) + 1;
-        m.target = Vec3(x, y, heights[h]);
+        m.target = Vec3(x, at_wall ? median_radius : e_.marker_y, heights[h]);
+        // Against the wall within three marker radii of the target if such a body
+        // is left, else the nearest of all.
         double best = std::numeric_limits<double>::infinity();
-        for (const auto& [id, ref] : bodies_) {
-          const double d = (bodyPosition(p, ref) - m.target).squaredNorm();
-          if (d < best && std::find(taken.begin(), taken.end(), id) == taken.end()) {
-            best = d;
-            m.id = id;
+        for (const bool wall_only : {at_wall, false}) {
+          for (const auto& [id, ref] : bodies_) {
+            if (wall_only && wall_gap.at(id) > 0.1 * median_radius) continue;
+            Vec3 d = bodyPosition(p, ref) - m.target;
+            if (wall_only) d.y() = 0.0;
+            if (wall_only && d.norm() > 3.0 * marker_radius_) continue;
+            if (d.squaredNorm() < best && std::find(taken.begin(), taken.end(), id) == taken.end()) {
+              best = d.squaredNorm();
+              m.id = id;
+            }
           }
+          if (std::isfinite(best)) break;
         }
         if (!std::isfinite(best)) continue;  // fewer bodies than markers
         taken.push_back(m.id);
@@ -214,6 +247,9 @@ class ChuteExperiment final : public Experiment {
     const double t = world->time();
     switchPhase(world, ctx, [&](sim::Model& m) { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; });
     gate_time_ = last_discharge_ = t;
+    // The lab sees the gate open in its film: travel counts from there, as the
+    // truth's does (the bed creeps a few mm while the chute tilts; that must not count).
+    if (tracking_) tracking_->setReferenceTime(t);
     bodies_ = indexBodies(world->particles());
     for (Marker& m : markers_) m.start = bodyPosition(world->particles(), bodies_.at(m.id));
     phase_ = Phase::Flow;
@@ -306,6 +342,8 @@ class ChuteExperiment final : public Experiment {
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
   std::unique_ptr<MarkerTracking> tracking_;
+  CameraSettings track_settings_;      // the tracked camera as the renderer has it (takes the calibration photos)
+  nlohmann::json calibration_report_;  // recovered against true camera (null: exact camera used)
   double marker_radius_ = 0.0;  // m
   bool has_top_ = false;
   Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
@@ -363,7 +401,16 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
                       {"frames_per_s", t.seconds > 0 ? static_cast<double>(t.frames) / t.seconds : 0.0},
                       {"method", "HSV red segmentation, redness-weighted centroids, Hungarian linking with constant-velocity "
                                  "prediction; pixel -> world on the plane of the marker centres; velocity from 2 mm to "
-                                 "measure_distance of travel along the base, as the truth"}};
+                                 "measure_distance of travel along the base, as the truth"},
+                      {"calibration", calibration_report_}};
+  if (!calibration_report_.is_null())
+    log << std::defaultfloat << std::setprecision(4) << "tracking camera calibrated from "
+        << calibration_report_["photos"].get<int>() << " checkerboard photos: fx "
+        << calibration_report_["fx_px"]["recovered"].get<double>() << " px (true "
+        << calibration_report_["fx_px"]["true"].get<double>() << "), camera position off by "
+        << 1e3 * calibration_report_["camera_position_error_m"].get<double>() << " mm, view direction by "
+        << calibration_report_["view_direction_error_deg"].get<double>() << " deg, RMS reprojection "
+        << calibration_report_["rms_reprojection_px"].get<double>() << " px\n";
   if (compared > 0) {
     s["rms_error_mps"] = std::sqrt(sum2 / compared);
     s["max_error_mps"] = max_abs;

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <ostream>
 
+#include "camera_calibration.h"
+#include "camera_recorder.h"
 #include "experiment.h"
 #include "heap_analysis.h"
 #include "plot.h"
@@ -18,14 +20,11 @@ namespace {
 class HeapExperiment final : public Experiment {
  public:
   explicit HeapExperiment(const Scene& scene) : e_(scene.experiment) {
-    if (!scene.cameras.empty()) {
-      camera_name_ = scene.cameras.front().name;
-      camera_ = scene.cameras.front().camera;
-    }
+    if (!scene.cameras.empty()) camera_ = scene.cameras.front();
   }
 
   // The photograph: the camera's last raw frame before the heap is measured.
-  std::string trackingCamera() const override { return balls_.empty() ? camera_name_ : std::string(); }
+  std::string trackingCamera() const override { return balls_.empty() ? camera_.name : std::string(); }
   void cameraFrame(std::uint64_t, double, const cv::Mat& raw) override { photo_ = raw.clone(); }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext&) override {
@@ -115,6 +114,18 @@ class HeapExperiment final : public Experiment {
       cx += b.centre.x() / static_cast<double>(balls_.size());
       cy += b.centre.y() / static_cast<double>(balls_.size());
     }
+    // The lab calibrates its camera with a board held in that plane (facing the
+    // camera), or trusts the renderer's camera when calibration_photos = 0.
+    const geometry::Vec3 axis_point(cx, cy, e_.base_z);
+    const geometry::Vec3 towards_camera(0.0, camera_.camera.position().y() > cy ? 1.0 : -1.0, 0.0);
+    nlohmann::json calibration;
+    geometry::Camera camera = camera_.camera;
+    if (e_.calibration_photos > 0) {
+      const WallCalibration cal =
+          calibrateOnWall(camera_.camera, renderOptionsFor(camera_), axis_point, towards_camera, e_.calibration_photos);
+      camera = cal.camera;
+      calibration = cal.report;
+    }
     std::vector<double> xs, zs;
     for (int u = 0; u < photo_.cols; ++u)
       for (int v = 2; v < photo_.rows; ++v) {
@@ -123,7 +134,7 @@ class HeapExperiment final : public Experiment {
           return std::max({p[0], p[1], p[2]}) > 70;
         };
         if (!(bright(v) && bright(v - 1) && bright(v - 2))) continue;  // three in a row: not a speck
-        if (const auto w = track::pixelToPlane(camera_, cv::Point2d(u, v - 2), {cx, cy, 0.0}, {0.0, 1.0, 0.0})) {
+        if (const auto w = track::pixelToPlane(camera, cv::Point2d(u, v - 2), axis_point, towards_camera)) {
           if (w->z() > e_.base_z + 0.005) {
             xs.push_back(w->x() - cx);
             zs.push_back(w->z() - e_.base_z);
@@ -159,6 +170,7 @@ class HeapExperiment final : public Experiment {
            {"flank_angles_deg", {angles[0], angles[1]}},
            {"angle_deg", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
            {"height_m", height},
+           {"calibration", calibration},
            {"method", "side photograph: top of the pile per pixel column, mapped onto the vertical plane through "
                       "the heap axis, least-squares line per flank between 20 % and 80 % of the height"}};
     if (std::isfinite(mean) && geometric.is_number())
@@ -168,8 +180,7 @@ class HeapExperiment final : public Experiment {
   }
 
   ExperimentSettings e_;
-  std::string camera_name_;
-  geometry::Camera camera_;
+  CameraSettings camera_;  // the first camera: it takes the photograph
   cv::Mat photo_;
   bool settled_ = false;
   double speed_ = 0, settle_time_ = 0;

@@ -29,7 +29,7 @@ MarkerTracking::Result MarkerTracking::finish() const {
   r.tracks = linker_.tracks();
   for (const track::Track& t : r.tracks)
     r.velocities.push_back(track::trackVelocity(t, camera_, planePoint(), geometry::Vec3::UnitY(),
-                                                -geometry::Vec3::UnitX(), measure_distance_, onset_));
+                                                -geometry::Vec3::UnitX(), measure_distance_, onset_, reference_time_));
   r.frames = frames_;
   r.seconds = seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

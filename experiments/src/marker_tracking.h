@@ -5,6 +5,7 @@
 // (-x), from 2 mm of travel to measure_distance, on the plane of the marker
 // centres (y = marker plane, one marker radius behind the camera-side wall).
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -24,6 +25,12 @@ class MarkerTracking {
   /// their equivalent radius, as the lab knows its painted pebbles: gives the
   /// expected blob area, so that touching markers are split into two.
   void setMarkers(double plane_y, double radius);
+  /// The camera the tracker works with (e.g. the one recovered by calibration);
+  /// call before setMarkers.
+  void setCamera(const geometry::Camera& camera) { camera_ = camera; }
+  /// Travel counts from each marker's position at this time (s; the gate opening),
+  /// interpolated between frames; before it is set, from a track's first frame.
+  void setReferenceTime(double time) { reference_time_ = time; }
   void addFrame(std::uint64_t frame, double time, const cv::Mat& bgr);
 
   struct Result {
@@ -40,6 +47,7 @@ class MarkerTracking {
   geometry::Camera camera_;
   double onset_, measure_distance_;
   double plane_y_ = 0.0;
+  double reference_time_ = std::numeric_limits<double>::quiet_NaN();
   track::DetectorSettings detector_;
   track::Linker linker_;
   std::uint64_t frames_ = 0;

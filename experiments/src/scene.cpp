@@ -447,6 +447,9 @@ void readExperiment(TableReader& root, const sim::Model& model, const std::vecto
     e.settle_speed = t->number("settle_speed", e.settle_speed, positive);
     e.settle_min_time = t->number("settle_min_time", e.settle_min_time, Range::nonNegative());
     e.settle_max_time = t->number("settle_max_time", e.settle_max_time, positive);
+    e.calibration_photos = static_cast<int>(t->integer("calibration_photos", e.calibration_photos, Range::closed(0, 11)));
+    if (e.calibration_photos > 0 && e.calibration_photos < 3)
+      t->fail("calibration_photos", "needs 0 (exact camera) or 3 to 11 photos (got " + std::to_string(e.calibration_photos) + ")");
   }
   if (e.type == "heap") {
     e.base_z = t->number("base_z", e.base_z);

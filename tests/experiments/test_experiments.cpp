@@ -101,6 +101,9 @@ TEST_CASE("heap: a small heap of clumps stands at a non-zero angle", "[experimen
   // angle from the positions within a few degrees.
   REQUIRE(r["heap"]["photograph"]["angle_deg"].is_number());
   CHECK(std::abs(r["heap"]["photograph"]["difference_to_geometric_deg"].get<double>()) < 4.0);
+  // ...read through the camera calibrated on a board in the plane of the heap axis.
+  const json& fx = r["heap"]["photograph"]["calibration"]["fx_px"];
+  CHECK(std::abs(fx["error"].get<double>()) < 0.005 * fx["true"].get<double>());
 }
 
 TEST_CASE("chute: a short clump chute discharges and reports its markers", "[experiment]") {
@@ -142,6 +145,14 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   REQUIRE(r.contains("tracking"));
   CHECK(r["tracking"]["markers_compared"].get<int>() >= 6);
   CHECK(r["tracking"]["max_error_pct"].get<double>() < 3.0);
+  // ...with the camera it recovered from checkerboard photos, not the renderer's.
+  const json& cal = r["tracking"]["calibration"];
+  REQUIRE(cal.is_object());
+  CHECK(cal["photos"] == 11);
+  CHECK(std::abs(cal["fx_px"]["error"].get<double>()) < 0.005 * cal["fx_px"]["true"].get<double>());
+  CHECK(std::abs(cal["fy_px"]["error"].get<double>()) < 0.005 * cal["fy_px"]["true"].get<double>());
+  CHECK(cal["camera_position_error_m"].get<double>() < 0.005);
+  CHECK(cal["view_direction_error_deg"].get<double>() < 0.5);
   CHECK(fs::exists(dir / "tracks.csv"));
   CHECK(fs::exists(dir / "profile.png"));
 }

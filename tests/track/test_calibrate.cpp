@@ -11,6 +11,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "rocklab/render/calibration_target.h"
 #include "rocklab/render/renderer.h"
 #include "rocklab/track/calibrate.h"
 #include "rocklab/track/plane.h"
@@ -127,4 +128,37 @@ TEST_CASE("calibration names the image whose corners are not found", "[track][ca
                     Catch::Contains("at least 3 images"));
   CHECK_THROWS_WITH(checkerboardPlanePose(images[2], {kCols, kRows}, kSquare, CalibrationResult{}),
                     Catch::Contains("no 9x6"));
+}
+
+TEST_CASE("an upright board is read right and up whichever corner the detector starts from", "[track][calibrate]") {
+  // The lab's board on a wall (the plane y = 0, seen from -y): columns along +x,
+  // rows up (+z). Photographed upright and with the camera rolled by 180 deg,
+  // findChessboardCorners starts from different corners; the board frame read
+  // with BoardAxes::RightAndUp follows the image (right, up) either way.
+  const std::vector<Camera> cameras = poses();
+  const CalibrationResult c = calibrateFromCheckerboards(renderBoards(cameras), {kCols, kRows}, kSquare);
+  render::BoardPlacement wall;
+  wall.rotation.col(0) = Vec3::UnitX();
+  wall.rotation.col(1) = Vec3::UnitZ();
+  wall.rotation.col(2) = -Vec3::UnitY();  // x × y: towards the camera
+  wall.origin = Vec3(-0.08, 0.0, -0.05);
+  const render::FrameDescription board = render::checkerboardFrame({kCols, kRows, kSquare}, wall);
+  for (const Vec3& up : std::vector<Vec3>{Vec3::UnitZ(), Vec3(0.2, 0.0, 1.0), Vec3(0.0, 0.0, -1.0)}) {
+    Camera camera = trueCamera();
+    camera.lookAt(Vec3(0.0, -0.45, 0.01), Vec3(0.0, 0.0, 0.0), up);
+    render::Renderer renderer(camera);
+    const cv::Mat image = renderer.render(board);
+    const PlanePose pose = checkerboardPlanePose(image, {kCols, kRows}, kSquare, c, BoardAxes::RightAndUp);
+    // Upright in the image: the board's x is the camera's right, its y the camera's up.
+    const Vec3 right = pose.rotation.col(0), rows = pose.rotation.col(1);
+    INFO("camera up " << up.transpose() << ": board x in camera " << right.transpose() << ", y " << rows.transpose());
+    CHECK(right.x() > 0.9);
+    CHECK(rows.y() < -0.9);  // camera y points down in the image
+    CHECK(pose.normal.z() < -0.99);  // towards the camera
+    if (up.z() > 0) {  // upright camera: the frame found is the lab's placement
+      const geometry::Mat3 expected = camera.rotation * wall.rotation;
+      CHECK((pose.rotation - expected).norm() < 0.02);
+      CHECK((pose.translation - camera.toCamera(wall.origin)).norm() < 1e-3);
+    }
+  }
 }

@@ -153,3 +153,25 @@ TEST_CASE("a synthetic red disc at constant velocity is tracked to 0.5 percent",
     CHECK((mv.start_world - start).norm() < 2e-4);
   }
 }
+
+TEST_CASE("travel counts from the reference time and earlier creep does not count", "[track][velocity]") {
+  // A marker creeps 3 mm at 0.03 m/s before the gate opens at t_g = 0.1 s (not on a
+  // sample), then moves off at constant acceleration from there: velocity over
+  // 100 mm from its position at t_g, as the truth's from the gate.
+  const double tg = 0.1013, creep = 0.03, a = 4.0, onset = 0.002, distance = 0.1;
+  auto travel = [&](double t) { return t < tg ? creep * (t - tg) : creep * (t - tg) + 0.5 * a * (t - tg) * (t - tg); };
+  std::vector<Vec3> world;
+  std::vector<double> time;
+  for (double t = 0.0; t < 0.5; t += 0.0005) time.push_back(t), world.push_back(Vec3(0.4 - travel(t), 0.0, 0.02));
+  auto timeAt = [&](double s) { return tg + (std::sqrt(creep * creep + 2 * a * s) - creep) / a; };
+  const double exact = (distance - onset) / (timeAt(distance) - timeAt(onset));
+  const MarkerVelocity fromGate = velocityOverDistance(world, time, Vec3(-1, 0, 0), distance, onset, tg);
+  const MarkerVelocity fromFirst = velocityOverDistance(world, time, Vec3(-1, 0, 0), distance, onset);
+  std::printf("with 3 mm of creep before the gate: %.5f m/s from the gate, %.5f m/s from the first frame, exact %.5f\n",
+              fromGate.velocity, fromFirst.velocity, exact);
+  CHECK(fromGate.velocity == Approx(exact).epsilon(1e-3));
+  CHECK(fromGate.start_world.x() == Approx(0.4 - travel(tg)).margin(1e-12));
+  CHECK(fromFirst.velocity < 0.95 * exact);  // counting the creep biases the velocity low
+  // A reference time after the last sample leaves nothing to measure.
+  CHECK_FALSE(velocityOverDistance(world, time, Vec3(-1, 0, 0), distance, onset, 1.0).complete);
+}

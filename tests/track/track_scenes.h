@@ -10,6 +10,7 @@
 
 #include "rocklab/geometry/camera.h"
 #include "rocklab/geometry/packing.h"
+#include "rocklab/render/calibration_target.h"
 #include "rocklab/render/frame.h"
 
 namespace rocklab::track::test {
@@ -62,26 +63,9 @@ inline Camera obliqueCamera(double k1 = -0.1, double k2 = 0.0) {
 }
 
 /// A flat checkerboard on z = 0: inner_cols × inner_rows inner corners, squares of
-/// `square` m, the first inner corner at the origin, x along the columns, y along
-/// the rows; a white border one square wide around it. Squares and border are
-/// separate coplanar polygons that never overlap (no depth fighting).
+/// `square` m, the first inner corner at the origin, x along the columns, y along the rows.
 inline render::FrameDescription checkerboard(int inner_cols, int inner_rows, double square) {
-  render::FrameDescription f;
-  const render::Rgb black{0.04f, 0.04f, 0.04f}, white{0.92f, 0.92f, 0.92f};
-  auto quad = [&](double x0, double y0, double x1, double y1, render::Rgb colour) {
-    f.polygons.push_back({{Vec3(x0, y0, 0), Vec3(x1, y0, 0), Vec3(x1, y1, 0), Vec3(x0, y1, 0)}, colour, 1.0f});
-  };
-  const double x0 = -square, y0 = -square;  // outer corner of the squares
-  const double x1 = x0 + (inner_cols + 1) * square, y1 = y0 + (inner_rows + 1) * square;
-  for (int i = 0; i <= inner_rows; ++i)
-    for (int j = 0; j <= inner_cols; ++j)
-      quad(x0 + j * square, y0 + i * square, x0 + (j + 1) * square, y0 + (i + 1) * square, (i + j) % 2 ? white : black);
-  const double m = square;  // border width
-  quad(x0 - m, y0 - m, x1 + m, y0, white);
-  quad(x0 - m, y1, x1 + m, y1 + m, white);
-  quad(x0 - m, y0, x0, y1, white);
-  quad(x1, y0, x1 + m, y1, white);
-  return f;
+  return render::checkerboardFrame({inner_cols, inner_rows, square});
 }
 
 /// The benchmark scene: 7,000 non-overlapping grey pebbles (radius 3–7 mm) in a

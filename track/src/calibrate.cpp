@@ -61,6 +61,19 @@ void checkBoard(cv::Size inner, double square) {
     throw std::invalid_argument("checkerboard square_m must be a finite length > 0 m");
 }
 
+// Reorders a row-major corner grid so that columns run right (+u) and rows up (−v)
+// in the image: a mirror within rows and/or of the row order.
+void orientRightAndUp(std::vector<cv::Point2f>& corners, cv::Size inner) {
+  const auto at = [&](int i, int j) -> cv::Point2f& { return corners[static_cast<std::size_t>(i * inner.width + j)]; };
+  const cv::Point2f along_row = at(0, inner.width - 1) - at(0, 0);
+  const cv::Point2f along_column = at(inner.height - 1, 0) - at(0, 0);
+  if (along_row.x < 0)
+    for (int i = 0; i < inner.height; ++i) std::reverse(&at(i, 0), &at(i, 0) + inner.width);
+  if (along_column.y > 0)
+    for (int i = 0; i < inner.height / 2; ++i)
+      std::swap_ranges(&at(i, 0), &at(i, 0) + inner.width, &at(inner.height - 1 - i, 0));
+}
+
 cv::Mat cameraMatrix(const CalibrationResult& c) {
   return (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
 }
@@ -105,12 +118,13 @@ CalibrationResult calibrateFromCheckerboards(const std::vector<cv::Mat>& images,
 }
 
 PlanePose checkerboardPlanePose(const cv::Mat& image, cv::Size inner_corners, double square_m,
-                                const CalibrationResult& calibration) {
+                                const CalibrationResult& calibration, BoardAxes axes) {
   checkBoard(inner_corners, square_m);
-  const std::vector<cv::Point2f> corners = findCorners(image, inner_corners);
+  std::vector<cv::Point2f> corners = findCorners(image, inner_corners);
   if (corners.empty())
     throw std::runtime_error("checkerboardPlanePose: no " + sizeText(inner_corners) +
                              " inner-corner checkerboard found in the image");
+  if (axes == BoardAxes::RightAndUp) orientRightAndUp(corners, inner_corners);
   const std::vector<cv::Point3f> board = boardPoints(inner_corners, square_m);
   const cv::Mat k = cameraMatrix(calibration);
   const cv::Mat dist = (cv::Mat_<double>(4, 1) << calibration.k1, calibration.k2, 0.0, 0.0);

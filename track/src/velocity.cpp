@@ -9,8 +9,35 @@
 
 namespace rocklab::track {
 
-MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world, const std::vector<double>& time,
-                                    const geometry::Vec3& direction, double distance, double onset) {
+namespace {
+
+// The trajectory from the reference time on: its first point interpolated at
+// t_ref, then the samples after it. Unchanged when t_ref is NaN or not after the
+// first sample; only the last sample when t_ref is after it.
+void startAt(double t_ref, std::vector<geometry::Vec3>& world, std::vector<double>& time) {
+  if (!(t_ref > time.front())) return;
+  std::size_t k = 1;
+  while (k < time.size() && time[k] <= t_ref) ++k;
+  if (k == time.size()) {
+    world = {world.back()};
+    time = {time.back()};
+    return;
+  }
+  const double f = (t_ref - time[k - 1]) / (time[k] - time[k - 1]);
+  const geometry::Vec3 at = world[k - 1] + f * (world[k] - world[k - 1]);
+  world.erase(world.begin(), world.begin() + static_cast<std::ptrdiff_t>(k));
+  time.erase(time.begin(), time.begin() + static_cast<std::ptrdiff_t>(k));
+  world.insert(world.begin(), at);
+  time.insert(time.begin(), t_ref);
+}
+
+}  // namespace
+
+MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world_in, const std::vector<double>& time_in,
+                                    const geometry::Vec3& direction, double distance, double onset,
+                                    double reference_time) {
+  std::vector<geometry::Vec3> world = world_in;
+  std::vector<double> time = time_in;
   if (world.empty() || world.size() != time.size()) {
     std::ostringstream s;
     s << "velocityOverDistance: needs as many times as points, at least one (got " << world.size() << " points, "
@@ -24,6 +51,7 @@ MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world, co
     s << "velocityOverDistance: needs 0 <= onset < distance (got onset " << onset << ", distance " << distance << ')';
     throw std::invalid_argument(s.str());
   }
+  startAt(reference_time, world, time);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const geometry::Vec3 unit = direction.normalized();
   MarkerVelocity out;
@@ -57,7 +85,7 @@ MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world, co
 
 MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera, const geometry::Vec3& plane_point,
                              const geometry::Vec3& plane_normal, const geometry::Vec3& direction, double distance,
-                             double onset) {
+                             double onset, double reference_time) {
   std::vector<geometry::Vec3> world;
   std::vector<double> time;
   for (const TrackPoint& p : track.points)
@@ -71,7 +99,7 @@ MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera,
     out.start_world = geometry::Vec3::Constant(nan);
     out.onset_time = out.end_time = out.velocity = nan;
   } else {
-    out = velocityOverDistance(world, time, direction, distance, onset);
+    out = velocityOverDistance(world, time, direction, distance, onset, reference_time);
   }
   out.track_id = track.id;
   return out;

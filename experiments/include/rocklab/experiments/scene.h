@@ -69,6 +69,8 @@ struct ExperimentSettings {
   double jam_time = 1.0;               // s without any discharge (bodies left) = jammed
   std::string track_camera;            // camera whose frames are tracked ("" = the first camera, if any)
   bool track = true;                   // track the markers in that camera's frames
+  int calibration_photos = 11;         // heap, chute: checkerboard photos the camera is calibrated from
+                                       // (3-11) before images are measured; 0 = the renderer's exact camera
 };
 
 /// Mass properties of one clump shape of the scene, for the log and results.json.

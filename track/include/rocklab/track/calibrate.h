@@ -40,10 +40,19 @@ struct PlanePose {
   double rms_px = 0;                               // reprojection error of this image
 };
 
+/// Which way the board frame is read from the image.
+enum class BoardAxes {
+  AsFound,     // findChessboardCorners' order (may start from any corner)
+  RightAndUp,  // the lab's convention for a board placed upright: its x axis (columns)
+               // points right in the image, its y axis (rows) up, so z = x × y points
+               // towards the camera. Unambiguous while the board is turned less than
+               // 45° in the image.
+};
+
 /// cv::solvePnP of the board in one image with calibrated intrinsics. Throws
 /// std::runtime_error when the corners are not found.
 PlanePose checkerboardPlanePose(const cv::Mat& image, cv::Size inner_corners, double square_m,
-                                const CalibrationResult& calibration);
+                                const CalibrationResult& calibration, BoardAxes axes = BoardAxes::AsFound);
 
 /// The calibrated camera with the board as the world frame (x, y on the board,
 /// z = 0 its plane): pixelToPlane(camera, px, 0, UnitZ) then reads board coordinates.
