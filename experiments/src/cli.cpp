@@ -8,6 +8,7 @@
 #include "rocklab/experiments/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/study.h"
 #include "rocklab/experiments/sweep.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/world.h"
@@ -28,6 +29,8 @@ Examples:
   rocklab calibrate drop --vary contact.damping_normal=0:0.4 --target restitution=0.72
   rocklab calibrate heap --vary materials.pebble.friction=0.2,0.3,0.4,0.5 --target angle_of_repose_deg=26.03
   rocklab sweep chute-30-clumps --vary experiment.inclination_deg=27,30,33   # one table + plot
+  rocklab study drop-timestep                    # built-in study: error of restitution against run time
+  rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
 
 Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
@@ -113,6 +116,18 @@ int runCli(int argc, const char* const* argv) {
   addSweepOptions(calibrate);
   calibrate->add_option("--target", target, "metric=value, e.g. angle_of_repose_deg=26.03")->required();
   calibrate->add_option("--iterations", iterations, "Bisection steps for a lo:hi range")->check(CLI::PositiveNumber);
+  std::string figure, reference;
+  double tolerance = -1.0;
+  auto* study = app.add_subcommand(
+      "study", "Error against run time: a figure for every --vary combination, against the finest or a lab value");
+  study->add_option("scene", scene_arg, "Scene file or name, or a study file / built-in study (assets/studies)")
+      ->required();
+  study->add_option("--vary", vary, "key=a,b,c from the cheapest to the finest value (replaces the study file's)");
+  study->add_option("--figure", figure, "results.json figure, dotted path (e.g. restitution, tracking.rms_error_pct)");
+  study->add_option("--reference", reference, "finest (default: the last variant) or a lab value");
+  study->add_option("--tolerance", tolerance, "error (%) the recommended variant may have (default 5)")
+      ->check(CLI::PositiveNumber);
+  addRunOptions(study);
 
   try {
     app.parse(argc, argv);
@@ -129,6 +144,37 @@ int runCli(int argc, const char* const* argv) {
 
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("render")) return renderRun({checkpoint_arg, camera_file, out_dir}, std::cerr);
+  if (app.got_subcommand("study")) {
+    std::signal(SIGINT, onSigint);
+    try {
+      StudyOptions so;
+      if (const auto file = findStudyFile(scene_arg)) so = loadStudyFile(*file);
+      else so.runs.scene = scene_arg;
+      so.runs.overrides.insert(so.runs.overrides.end(), overrides.begin(), overrides.end());
+      if (!vary.empty()) so.runs.vary.clear();
+      for (const std::string& v : vary) so.runs.vary.push_back(parseVary(v));
+      if (!figure.empty()) so.figure = figure;
+      if (reference == "finest") so.reference.reset();
+      else if (!reference.empty()) {
+        std::size_t used = 0;
+        try {
+          so.reference = std::stod(reference, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != reference.size())
+          throw std::invalid_argument("--reference '" + reference + "': give finest or a number (a lab value)");
+      }
+      if (tolerance > 0) so.tolerance_pct = tolerance;
+      so.runs.out_dir = out_dir;
+      so.runs.threads = threads;
+      so.runs.progress = !quiet;
+      return runStudy(so, std::cerr);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
   if (app.got_subcommand("sweep") || app.got_subcommand("calibrate")) {
     SweepOptions so;
     so.scene = scene_arg;

@@ -532,6 +532,14 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
     const std::string mass = t->string("damping_mass", "average", {"average", "reduced"});
     model.contact.damping_mass = mass == "average" ? sim::DampingMass::Average : sim::DampingMass::Reduced;
     model.contact.local_damping = t->number("local_damping", 0.0, {0.0, 1.0, false, true});
+    // Stiffness scaling, the usual way DEM users buy speed (dt_crit ~ 1/sqrt(k)):
+    // one factor on every material's kn, ks and G, so a study varies one key.
+    const double scale = t->number("stiffness_scale", 1.0, Range::positive());
+    for (auto& m : model.materials) {
+      m.kn *= scale;
+      m.ks *= scale;
+      m.shear_modulus *= scale;
+    }
     t->finish();
   }
   if (model.contact.law == sim::ContactLaw::HertzMindlin)

@@ -11,6 +11,7 @@
 
 #include "atomic_file.h"
 #include "plot.h"
+#include "run_set.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 
@@ -19,6 +20,7 @@ namespace rocklab::experiments {
 namespace {
 
 using json = nlohmann::json;
+using namespace detail;
 
 /// The figures a sweep reports when none are named: the experiment's headline.
 std::vector<std::string> defaultMetrics(const Scene& scene) {
@@ -32,126 +34,21 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   return m;
 }
 
-/// results.json value at a dotted path ("wall_time_s.total"); null when absent.
-json lookup(const json& r, const std::string& path) {
-  const json* node = &r;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t dot = path.find('.', start);
-    const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (node->is_array()) {  // a numeric part indexes an array: clump_shapes.0.mass_kg
-      std::size_t used = 0, index = 0;
-      try {
-        index = std::stoul(key, &used);
-      } catch (const std::exception&) {
-        return nullptr;
-      }
-      if (used != key.size() || index >= node->size()) return nullptr;
-      node = &(*node)[index];
-    } else {
-      if (!node->is_object() || !node->contains(key)) return nullptr;
-      node = &(*node)[key];
-    }
-    if (dot == std::string::npos) return *node;
-    start = dot + 1;
-  }
-}
-
-std::string cell(const json& v) {
-  if (v.is_null()) return "";
-  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
-  if (v.is_number()) {
-    std::ostringstream s;
-    s << std::setprecision(6) << v.get<double>();
-    return s.str();
-  }
-  return v.is_string() ? v.get<std::string>() : v.dump();
-}
-
-struct Point {
-  std::vector<std::string> values;  // one per varied key
-  json results;
-  int code = kExitOk;
-};
-
-/// Loads the scene with the fixed and the varied assignments (throws SceneError).
-Scene sceneFor(const SweepOptions& o, const std::vector<std::string>& values) {
-  std::vector<std::string> overrides = o.overrides;
-  for (std::size_t k = 0; k < o.vary.size(); ++k) overrides.push_back(o.vary[k].first + "=" + values[k]);
-  return loadScene(resolveScene(o.scene), overrides);
-}
-
-/// Runs one point into dir (its log in dir/run.log); fills p.results.
-void runPoint(const SweepOptions& o, const std::filesystem::path& dir, Point& p, std::ostream& log) {
-  Scene scene = sceneFor(o, p.values);
-  std::filesystem::create_directories(dir);
-  RunOptions ro;
-  ro.out_dir = dir;
-  ro.threads = o.threads;
-  ro.progress = o.progress;
-  std::ofstream run_log(dir / "run.log");
-  p.code = runScene(scene, ro, run_log);
-  std::ifstream in(dir / "results.json");
-  if (in) p.results = json::parse(in, nullptr, false);
-  log << "  ";
-  for (std::size_t k = 0; k < o.vary.size(); ++k) log << o.vary[k].first << " = " << p.values[k] << "  ";
-  log << "-> " << (p.code == kExitOk ? "done" : "exit " + std::to_string(p.code)) << " (" << dir.string() << ")\n";
-}
-
-std::filesystem::path outDirFor(const SweepOptions& o, const Scene& scene, const std::string& suffix) {
-  return o.out_dir.empty() ? std::filesystem::path("out") / (scene.run.name + suffix) : o.out_dir;
-}
-
-/// Writes the table (CSV with the metric paths as headers) and prints it aligned.
-void writeTable(const SweepOptions& o, const std::vector<std::string>& metrics, const std::vector<Point>& points,
-                const std::filesystem::path& csv_path, std::ostream& log) {
+/// The sweep's table: the varied values, the chosen figures, how each run ended.
+void writeMetricTable(const SweepOptions& o, const std::vector<std::string>& metrics, const std::vector<Variant>& points,
+                      const std::filesystem::path& csv_path, std::ostream& log) {
   std::vector<std::string> header;
   for (const auto& [key, values] : o.vary) header.push_back(key);
   for (const auto& m : metrics) header.push_back(m);
   header.push_back("status");
   std::vector<std::vector<std::string>> rows;
-  for (const Point& p : points) {
+  for (const Variant& p : points) {
     std::vector<std::string> row = p.values;
     for (const auto& m : metrics) row.push_back(cell(lookup(p.results, m)));
     row.push_back(p.code == kExitOk ? "ok" : "exit " + std::to_string(p.code));
     rows.push_back(row);
   }
-  std::ostringstream csv;
-  for (std::size_t c = 0; c < header.size(); ++c) csv << (c ? "," : "") << header[c];
-  csv << "\n";
-  for (const auto& row : rows) {
-    for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << row[c];
-    csv << "\n";
-  }
-  detail::writeAtomically(csv_path, csv.str());
-  std::vector<std::size_t> width(header.size());
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    width[c] = header[c].size();
-    for (const auto& row : rows) width[c] = std::max(width[c], row[c].size());
-  }
-  auto print = [&](const std::vector<std::string>& row) {
-    for (std::size_t c = 0; c < row.size(); ++c) log << (c ? "  " : "  ") << std::setw(static_cast<int>(width[c])) << row[c];
-    log << "\n";
-  };
-  print(header);
-  for (const auto& row : rows) print(row);
-}
-
-double number(const json& v) {
-  if (v.is_number()) return v.get<double>();
-  if (v.is_boolean()) return v.get<bool>() ? 1.0 : 0.0;
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
-double toDouble(const std::string& text, const std::string& what) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
-    return v;
-  } catch (const std::exception&) {
-    throw std::invalid_argument(what + ": '" + text + "' is not a number");
-  }
+  writeTable(header, rows, csv_path, log);
 }
 
 }  // namespace
@@ -185,20 +82,10 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
   }
   // Every combination, the first key slowest; each scene is loaded (validated)
   // before anything runs, so a bad value costs nothing.
-  std::vector<Point> points(1);
-  for (const auto& [key, values] : o.vary) {
-    std::vector<Point> next;
-    for (const Point& p : points)
-      for (const std::string& v : values) {
-        Point q = p;
-        q.values.push_back(v);
-        next.push_back(q);
-      }
-    points = next;
-  }
+  std::vector<Variant> points = expandVariants(o);
   Scene first;
   try {
-    for (const Point& p : points) first = sceneFor(o, p.values);
+    for (const Variant& p : points) first = sceneFor(o, p.values);
     first = sceneFor(o, points.front().values);
   } catch (const SceneError& e) {
     log << "error: " << e.what() << "\n";
@@ -209,18 +96,16 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
   std::filesystem::create_directories(dir);
   log << "sweep of " << first.run.name << ": " << points.size() << " runs into " << dir.string() << "\n";
   int code = kExitOk;
-  std::vector<Point> done;
+  std::vector<Variant> done;
   for (std::size_t k = 0; k < points.size(); ++k) {
-    std::ostringstream name;
-    name << "run-" << std::setw(3) << std::setfill('0') << k;
-    runPoint(o, dir / name.str(), points[k], log);
+    runVariant(o, dir / variantFolder(k), points[k], log);
     done.push_back(points[k]);
     if (points[k].code == kExitInterrupted) {
       code = kExitInterrupted;
       break;
     }
   }
-  writeTable(o, metrics, done, dir / "sweep.csv", log);
+  writeMetricTable(o, metrics, done, dir / "sweep.csv", log);
   // Plot: the first metric against the first key; one series per value of the second key.
   PlotSpec spec;
   spec.title = first.run.name + ": " + metrics.front() + " against " + o.vary.front().first;
@@ -230,7 +115,7 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
   for (std::size_t g = 0; g < groups; ++g) {
     PlotSeries s;
     if (o.vary.size() > 1) s.label = o.vary[1].first + " = " + o.vary[1].second[g];
-    for (const Point& p : done) {
+    for (const Variant& p : done) {
       if (o.vary.size() > 1 && p.values[1] != o.vary[1].second[g]) continue;
       try {
         s.x.push_back(toDouble(p.values[0], o.vary.front().first));
@@ -281,13 +166,11 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
   const std::filesystem::path dir = outDirFor(o, first, "-calibrate");
   std::filesystem::create_directories(dir);
   log << "calibrate " << first.run.name << ": " << key << " for " << c.target_metric << " = " << c.target << "\n";
-  std::vector<Point> tried;
+  std::vector<Variant> tried;
   auto evaluate = [&](double v) -> double {
-    Point p;
+    Variant p;
     p.values = {cell(v)};
-    std::ostringstream name;
-    name << "run-" << std::setw(3) << std::setfill('0') << tried.size();
-    runPoint(o, dir / name.str(), p, log);
+    runVariant(o, dir / variantFolder(tried.size()), p, log);
     tried.push_back(p);
     if (p.code == kExitInterrupted) throw std::runtime_error("interrupted");
     return number(lookup(p.results, c.target_metric)) - c.target;
@@ -329,10 +212,10 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
       if (!std::isfinite(estimate)) how = "the target is not between any two neighbouring values";
     }
   } catch (const std::runtime_error&) {
-    writeTable(o, metrics, tried, dir / "calibration.csv", log);
+    writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
     return kExitInterrupted;
   }
-  writeTable(o, metrics, tried, dir / "calibration.csv", log);
+  writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
   json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
               {"target", c.target},      {"method", how},        {"runs", tried.size()},
               {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)}};

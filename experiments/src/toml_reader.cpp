@@ -1,5 +1,6 @@
 #include "toml_reader.h"
 
+#include <charconv>
 #include <sstream>
 
 namespace rocklab::experiments::detail {
@@ -193,6 +194,27 @@ std::vector<double> TableReader::numberList(const std::string& key, Range range)
   return out;
 }
 
+std::vector<std::string> TableReader::valueTextList(const std::string& key) {
+  const toml::node* n = node(key);
+  std::vector<std::string> out;
+  if (!n) return out;
+  auto a = n->as_array();
+  if (!a) fail(key, "expected an array of values, got " + typeName(*n));
+  for (const toml::node& e : *a) {
+    if (e.is_table() || e.is_array_of_tables()) fail(key, "expected values, got a table");
+    if (const auto f = e.as_floating_point()) {  // shortest text that reads back the same: 0.3, not 0.2999...
+      char buffer[64];
+      const auto end = std::to_chars(buffer, buffer + sizeof buffer, f->get()).ptr;
+      std::string text(buffer, end);
+      if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // stays a TOML float
+      out.push_back(text);
+    } else {
+      out.push_back(fmtValue(e));
+    }
+  }
+  return out;
+}
+
 std::vector<std::string> TableReader::stringList(const std::string& key, const std::vector<std::string>& allowed) {
   const toml::node* n = node(key);
   std::vector<std::string> out;
@@ -258,7 +280,13 @@ void applyOverride(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
     throw SceneError("--set " + assignment + ": expected key=value, e.g. --set timestep.dt=1e-6");
-  const std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  // Spaces around '=' are allowed (study files write "key = value").
+  const auto trim = [](std::string t) {
+    const auto a = t.find_first_not_of(" \t"), b = t.find_last_not_of(" \t");
+    return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
+  };
+  const std::string key = trim(assignment.substr(0, eq)), value = trim(assignment.substr(eq + 1));
+  if (key.empty()) throw SceneError("--set " + assignment + ": expected key=value, e.g. --set timestep.dt=1e-6");
   // The value is TOML; a bare word that is not TOML is taken as a string.
   toml::table parsed;
   try {

@@ -51,6 +51,9 @@ class TableReader {
   std::vector<geometry::Vec3> vec3List(const std::string& key);
   std::vector<double> numberList(const std::string& key, Range range = {});
   std::vector<std::string> stringList(const std::string& key, const std::vector<std::string>& allowed = {});
+  /// An array of any TOML values, each as TOML text ("0.5", "\"linear\"", "[960, 400]"),
+  /// the form --set takes.
+  std::vector<std::string> valueTextList(const std::string& key);
   std::optional<TableReader> table(const std::string& key);
   std::vector<TableReader> tableArray(const std::string& key);
   /// Names of all keys of this table (for tables of named entries).

@@ -1,0 +1,47 @@
+#pragma once
+// What sweep, calibrate and study share: a scene run once per variant (a value
+// for each varied key, applied like --set), one output folder per run, and the
+// results.json figures read back by dotted path. Internal to rocklab_experiments.
+#include <filesystem>
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/sweep.h"
+
+namespace rocklab::experiments::detail {
+
+/// One run of a set: its values (one per varied key), what it reported, how it ended.
+struct Variant {
+  std::vector<std::string> values;
+  nlohmann::json results;
+  int code = kExitOk;
+};
+
+/// Every combination of the varied values, the first key slowest.
+std::vector<Variant> expandVariants(const SweepOptions& o);
+/// Loads the scene with the fixed and the varied assignments (throws SceneError).
+Scene sceneFor(const SweepOptions& o, const std::vector<std::string>& values);
+/// Runs one variant into dir (its log in dir/run.log); fills v.results and v.code.
+void runVariant(const SweepOptions& o, const std::filesystem::path& dir, Variant& v, std::ostream& log);
+/// The folder of a set: --out, else out/<scene name><suffix>.
+std::filesystem::path outDirFor(const SweepOptions& o, const Scene& scene, const std::string& suffix);
+/// "run-007": the folder of the k-th variant.
+std::string variantFolder(std::size_t k);
+
+/// results.json value at a dotted path ("wall_time_s.total"); null when absent.
+nlohmann::json lookup(const nlohmann::json& r, const std::string& path);
+/// A table cell: numbers with 6 digits, booleans as true/false, null as "".
+std::string cell(const nlohmann::json& v);
+/// A number, a boolean as 0/1, anything else NaN.
+double number(const nlohmann::json& v);
+/// Parses a whole string as a finite number; throws std::invalid_argument naming `what`.
+double toDouble(const std::string& text, const std::string& what);
+/// Writes the table as CSV (atomically) and prints it aligned.
+void writeTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
+                const std::filesystem::path& csv_path, std::ostream& log);
+
+}  // namespace rocklab::experiments::detail

@@ -1,0 +1,279 @@
+#include "rocklab/experiments/study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "atomic_file.h"
+#include "plot.h"
+#include "run_set.h"
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+#include "toml_reader.h"
+
+#ifndef ROCKLAB_ASSET_DIR
+#define ROCKLAB_ASSET_DIR "assets"
+#endif
+
+namespace rocklab::experiments {
+
+using json = nlohmann::json;
+using namespace detail;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string joinValues(const SweepOptions& o, const std::vector<std::string>& values) {
+  std::string s;
+  for (std::size_t k = 0; k < values.size(); ++k) s += (k ? ", " : "") + o.vary[k].first + " = " + values[k];
+  return s;
+}
+
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+/// The sentence a user reads: which variant to take and what it costs.
+std::string recommendation(const StudyOptions& o, const StudyAnalysis& a, const std::string& reference_text) {
+  std::ostringstream s;
+  if (!a.recommended) {
+    s << "no variant is within " << o.tolerance_pct << " % of " << reference_text << "; refine further";
+    return s.str();
+  }
+  const StudyPoint& best = a.points[*a.recommended];
+  s << joinValues(o.runs, best.values);
+  if (best.is_reference) {
+    s << " (the finest): no cheaper variant is within " << o.tolerance_pct << " % of it together with all finer ones";
+    return s.str();
+  }
+  s << ": " << o.figure << " " << fixed(best.figure, 6) << " is " << fixed(best.error_pct, 3) << " % from "
+    << reference_text << ", and so is every finer variant (tolerance " << o.tolerance_pct << " %), for "
+    << fixed(best.wall_s, 3) << " s of wall time";
+  double finest_wall = 0.0;
+  for (const StudyPoint& p : a.points)
+    if (p.ok) finest_wall = std::max(finest_wall, p.wall_s);
+  if (best.wall_s > 0 && finest_wall > best.wall_s)
+    s << " (the dearest variant took " << fixed(finest_wall, 3) << " s, " << fixed(finest_wall / best.wall_s, 3)
+      << "x as long)";
+  return s.str();
+}
+
+/// log10(error %) against log10(wall time), the Pareto front joined.
+void writeStudyPlot(const StudyOptions& o, const StudyAnalysis& a, const std::string& name,
+                    const std::filesystem::path& png) {
+  PlotSeries all{"variants", {}, {}, PlotSeries::Style::Points};
+  PlotSeries front{"Pareto front", {}, {}, PlotSeries::Style::LinePoints};
+  std::vector<std::pair<double, double>> f;
+  const bool relative = a.reference != 0.0;  // a reference of 0: the figure is an error already
+  for (const StudyPoint& p : a.points) {
+    const double e = relative ? p.error_pct : p.error;
+    if (!p.ok || p.is_reference || !(e > 0) || !(p.wall_s > 0)) continue;  // log scale: no zero error
+    all.x.push_back(std::log10(p.wall_s));
+    all.y.push_back(std::log10(e));
+    if (p.pareto) f.emplace_back(std::log10(p.wall_s), std::log10(e));
+  }
+  std::sort(f.begin(), f.end());
+  for (const auto& [x, y] : f) front.x.push_back(x), front.y.push_back(y);
+  PlotSpec spec;
+  spec.title = name + ": error of " + o.figure + " against run time";
+  spec.x_label = "log10 wall time (s)";
+  spec.y_label = relative ? "log10 error (%)" : "log10 |" + o.figure + "|";
+  spec.series = {all, front};
+  writePlot(spec, png);
+}
+
+}  // namespace
+
+StudyAnalysis analyseStudy(std::vector<StudyPoint> points, std::optional<double> reference, double tolerance_pct) {
+  StudyAnalysis a;
+  if (reference) {
+    a.reference = *reference;
+  } else {
+    a.reference = kNaN;
+    for (auto it = points.rbegin(); it != points.rend(); ++it)
+      if (it->ok) {
+        it->is_reference = true;
+        a.reference = it->figure;
+        break;
+      }
+  }
+  for (StudyPoint& p : points) {
+    p.error = p.ok ? std::abs(p.figure - a.reference) : kNaN;
+    p.error_pct = p.ok && a.reference != 0.0 ? 100.0 * p.error / std::abs(a.reference) : kNaN;
+  }
+  // Pareto: no other ok point is at most as dear and at most as far, and better in one.
+  const auto err = [&](const StudyPoint& p) { return std::isfinite(p.error_pct) ? p.error_pct : p.error; };
+  for (StudyPoint& p : points) {
+    if (!p.ok || !std::isfinite(err(p))) continue;
+    p.pareto = std::none_of(points.begin(), points.end(), [&](const StudyPoint& q) {
+      return q.ok && std::isfinite(err(q)) && q.wall_s <= p.wall_s && err(q) <= err(p) &&
+             (q.wall_s < p.wall_s || err(q) < err(p));
+    });
+  }
+  bool tail_within = true;  // every ok point after k is within the tolerance
+  for (std::size_t k = points.size(); k-- > 0;) {
+    const StudyPoint& p = points[k];
+    if (!p.ok) continue;
+    tail_within = tail_within && err(p) <= tolerance_pct;
+    if (!tail_within) break;
+    if (!a.recommended || p.wall_s < points[*a.recommended].wall_s) a.recommended = k;
+  }
+  a.points = std::move(points);
+  return a;
+}
+
+int runStudy(const StudyOptions& o, std::ostream& log) {
+  if (o.runs.vary.empty()) {
+    log << "error: study: give at least one --vary key=a,b,c (from the cheapest to the finest value)\n";
+    return kExitBadInput;
+  }
+  if (o.figure.empty()) {
+    log << "error: study: give --figure, a results.json path such as restitution or tracking.rms_error_pct\n";
+    return kExitBadInput;
+  }
+  std::vector<Variant> variants = expandVariants(o.runs);
+  Scene first;
+  try {
+    for (const Variant& v : variants) first = sceneFor(o.runs, v.values);  // every scene valid before any run
+    first = sceneFor(o.runs, variants.front().values);
+  } catch (const SceneError& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const std::filesystem::path dir = outDirFor(o.runs, first, "-study");
+  std::filesystem::create_directories(dir);
+  log << "study of " << first.run.name << ": " << o.figure << " for " << variants.size() << " variants into "
+      << dir.string() << "\n";
+  if (!o.description.empty()) log << "  " << o.description << "\n";
+  int code = kExitOk;
+  std::vector<StudyPoint> points;
+  for (std::size_t k = 0; k < variants.size(); ++k) {
+    runVariant(o.runs, dir / variantFolder(k), variants[k], log);
+    StudyPoint p;
+    p.values = variants[k].values;
+    p.figure = number(lookup(variants[k].results, o.figure));
+    p.wall_s = number(lookup(variants[k].results, "wall_time_s.total"));
+    p.ok = variants[k].code == kExitOk && std::isfinite(p.figure);
+    points.push_back(p);
+    if (variants[k].code == kExitInterrupted) {
+      code = kExitInterrupted;
+      break;
+    }
+  }
+  const StudyAnalysis a = analyseStudy(points, o.reference, o.tolerance_pct);
+  const std::string reference_text =
+      o.reference ? "the reference value " + fixed(a.reference, 6) : "the finest variant (" + fixed(a.reference, 6) + ")";
+
+  std::vector<std::string> header;
+  for (const auto& [key, values] : o.runs.vary) header.push_back(key);
+  for (const char* h : {"error", "error_pct", "wall_time_s", "pareto", "reference", "status"}) header.push_back(h);
+  header.insert(header.begin() + static_cast<std::ptrdiff_t>(o.runs.vary.size()), o.figure);
+  std::vector<std::vector<std::string>> rows;
+  json rows_json = json::array();
+  for (std::size_t k = 0; k < a.points.size(); ++k) {
+    const StudyPoint& p = a.points[k];
+    std::vector<std::string> row = p.values;
+    const std::string status = variants[k].code == kExitOk ? (p.ok ? "ok" : "no figure") : "exit " + std::to_string(variants[k].code);
+    for (const std::string& c : {fixed(p.figure, 8), fixed(p.error, 4), fixed(p.error_pct, 4), fixed(p.wall_s, 4),
+                                 std::string(p.pareto ? "yes" : ""), std::string(p.is_reference ? "yes" : ""), status})
+      row.push_back(c);
+    rows.push_back(row);
+    json values = json::object();
+    for (std::size_t j = 0; j < p.values.size(); ++j) values[o.runs.vary[j].first] = p.values[j];
+    rows_json.push_back({{"values", values},
+                         {"folder", variantFolder(k)},
+                         {"figure", std::isfinite(p.figure) ? json(p.figure) : json(nullptr)},
+                         {"error", std::isfinite(p.error) ? json(p.error) : json(nullptr)},
+                         {"error_pct", std::isfinite(p.error_pct) ? json(p.error_pct) : json(nullptr)},
+                         {"wall_time_s", std::isfinite(p.wall_s) ? json(p.wall_s) : json(nullptr)},
+                         {"pareto", p.pareto},
+                         {"reference", p.is_reference},
+                         {"status", status}});
+  }
+  writeTable(header, rows, dir / "study.csv", log);
+  const std::string line = recommendation(o, a, reference_text);
+  log << "recommendation: " << line << "\n";
+  json out = {{"scene", first.run.name},
+              {"description", o.description},
+              {"figure", o.figure},
+              {"reference", {{"kind", o.reference ? "value" : "finest"},
+                             {"value", std::isfinite(a.reference) ? json(a.reference) : json(nullptr)}}},
+              {"tolerance_pct", o.tolerance_pct},
+              {"variants", rows_json},
+              {"recommended", a.recommended ? json(variantFolder(*a.recommended)) : json(nullptr)},
+              {"recommendation", line},
+              {"complete", code == kExitOk}};
+  detail::writeAtomically(dir / "study.json", out.dump(2) + "\n");
+  try {
+    writeStudyPlot(o, a, first.run.name, dir / "study.png");
+  } catch (const std::exception& e) {
+    log << "study: no plot (" << e.what() << ")\n";
+  }
+  log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << "\n";
+  return code;
+}
+
+std::filesystem::path builtinStudyDir() { return std::filesystem::path(ROCKLAB_ASSET_DIR) / "studies"; }
+
+std::optional<std::filesystem::path> findStudyFile(const std::string& name_or_path) {
+  std::filesystem::path p(name_or_path);
+  if (!std::filesystem::exists(p) && p.extension().empty() && p.parent_path().empty())
+    p = builtinStudyDir() / (name_or_path + ".toml");
+  if (!std::filesystem::is_regular_file(p) || p.extension() != ".toml") return std::nullopt;
+  try {
+    const toml::table t = toml::parse_file(p.string());
+    if (t.contains("study")) return p;
+  } catch (const toml::parse_error&) {
+    return std::nullopt;  // not ours: the scene reader will report it
+  }
+  return std::nullopt;
+}
+
+StudyOptions loadStudyFile(const std::filesystem::path& file) {
+  toml::table root;
+  try {
+    root = toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw SceneError(file.string() + ": " + std::string(e.description()));
+  }
+  TableReader top(root, "");
+  auto t = top.table("study");
+  if (!t) throw SceneError(file.string() + ": no [study] table");
+  StudyOptions o;
+  o.description = t->string("description", "");
+  std::string scene = t->requiredString("scene");
+  // A scene file named relative to the study file; else a built-in scene name.
+  if (std::filesystem::path(scene).extension() == ".toml" && std::filesystem::path(scene).is_relative())
+    scene = (file.parent_path() / scene).string();
+  o.runs.scene = scene;
+  o.figure = t->requiredString("figure");
+  if (t->has("reference") && t->raw()["reference"].is_number()) {
+    o.reference = t->number("reference", 0.0);
+  } else {
+    t->string("reference", "finest", {"finest"});
+  }
+  o.tolerance_pct = t->number("tolerance_pct", o.tolerance_pct, Range::positive());
+  o.runs.overrides = t->stringList("set");
+  for (TableReader& v : t->tableArray("vary")) {
+    const std::string key = v.requiredString("key");
+    std::vector<std::string> values = v.valueTextList("values");
+    if (values.empty()) v.fail("values", "give at least one value");
+    o.runs.vary.emplace_back(key, values);
+    v.finish();
+  }
+  if (o.runs.vary.empty()) t->fail("vary", "give at least one [[study.vary]] with key and values");
+  t->finish();
+  top.finish();
+  return o;
+}
+
+}  // namespace rocklab::experiments
