@@ -40,9 +40,10 @@ double dampingFromRestitution(double restitution);
 
 /// The automatic step stays below this fraction of the damped stability limit
 /// (ref §7a: "lower for high damping ratios"). With the study's beta = 0.11 the
-/// spring criterion (safety 0.5) is at most ~0.6 of that limit, so the cap does
-/// not bind there; it binds for strong dashpots (beta_s above ~0.2 between equal
-/// spheres, or the average-mass dashpot of a light fragment on a heavy rock).
+/// spring criterion (safety 0.5) is 0.73 (spheres) to 0.80 (four-ball clumps,
+/// just below the cap) of that limit, so every built-in scene keeps its step; the
+/// cap binds for stronger dashpots and for the average-mass dashpot of a light
+/// fragment on a heavy rock.
 inline constexpr double kDampedMargin = 0.8;
 /// The dashpot is counted this many times in the damped limit: a ball pressed
 /// from both sides (the fastest mode of a chain, and of a column in a pile) is
