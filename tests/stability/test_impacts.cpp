@@ -241,3 +241,34 @@ TEST_CASE("damped stability limit: the leapfrog with a lagged dashpot diverges j
       CHECK_FALSE(amplitude(1.01 * limit) < 1e-3);  // grown (or overflowed to inf/NaN)
     }
 }
+
+TEST_CASE("Hertz-Mindlin G from 1 kPa to 10 TPa: a rock resting on a floor under gravity", "[stability]") {
+  // Static overlap of the ball–wall Hertz contact: m g = c d^(3/2), c with R~ = R.
+  const double r = kRock, m = sphereMass(r);
+  for (double g : {1e3, 1e4, 1e5, 1e7, 1e9, 1e11, 1e13}) {
+    INFO("G = " << g << " Pa");
+    sim::Model model = hertz(g, 0.37, 0.11);
+    model.gravity = Vec3(0, 0, -9.81);
+    model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
+    const double c = sim::hertzCoefficient(g, 0.2, r);
+    const double d = std::pow(m * 9.81 / c, 2.0 / 3.0);
+    sim::World w(model, {ball({0, 0, r}, r)}, 1);  // just touching, released
+    const Outcome o = run(w, 20000, 20);
+    REQUIRE(o.finite);
+    // Dropping from touch, the first dip reaches up to 2^(2/3) x the static overlap.
+    if (d / r > 0.5) {
+      CHECK(o.stopped);
+      CHECK_THAT(o.message, Catch::Contains("overlap of particle 0 with wall 'floor'"));
+      figure("Hertz G=" + num(g) + " rock at rest on a floor", "static overlap " + num(d / r, 3) +
+                                                                 " r: watchdog at step " + std::to_string(o.steps));
+    } else if (std::pow(2.0, 2.0 / 3.0) * d / r < 0.5) {
+      CHECK_FALSE(o.stopped);
+      const double overlap = r - w.particles().position[0].z();
+      CHECK(overlap == Approx(d).epsilon(0.05));
+      CHECK(o.max_overlap < std::pow(2.0, 2.0 / 3.0) * d / r * 1.05);
+      figure("Hertz G=" + num(g) + " rock at rest on a floor", "stable: overlap " + num(overlap / r, 3) +
+                                                                 " r (static " + num(d / r, 3) + " r), dt " +
+                                                                 num(w.dt(), 3) + " s");
+    }
+  }
+}
