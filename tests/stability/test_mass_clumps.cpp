@@ -63,7 +63,9 @@ TEST_CASE("damped cap: the old step (0.5 x critical) on the 1e4 fragment and on 
   }
 }
 
-TEST_CASE("light 4 mm fragment riding a 1e13 N/m wall that oscillates at 200 Hz", "[stability]") {
+namespace {
+
+void fragmentRidingWall(std::uint64_t steps, const std::string& name) {
   // The wall (the crusher's stiffness, infinitely heavy) moves z = A sin(2 pi f t)
   // with A f^2 (2 pi)^2 = 3.2 m/s^2 < g: the fragment must ride it, never leave it.
   sim::Model model = linearPair(1e9, 0.37, 0.11);
@@ -80,7 +82,7 @@ TEST_CASE("light 4 mm fragment riding a 1e13 N/m wall that oscillates at 200 Hz"
   const double w_peak = A * 2 * std::numbers::pi * f;
   sim::World w(model, {ball({0, 0, r - rest}, r, {0, 0, w_peak})}, 1);  // moving with the wall
   double worst_gap = 0.0, worst_overlap = 0.0;
-  const Outcome o = run(w, 60000, 10, [&](const sim::Snapshot& s) {
+  const Outcome o = run(w, steps, 10, [&](const sim::Snapshot& s) {
     const double z_wall = A * std::sin(2 * std::numbers::pi * f * s.time);
     const double overlap = r - (s.position[0].z() - z_wall);
     worst_gap = std::max(worst_gap, -overlap);
@@ -92,9 +94,18 @@ TEST_CASE("light 4 mm fragment riding a 1e13 N/m wall that oscillates at 200 Hz"
   CHECK(worst_gap < 0.01 * A);               // rides the wall
   CHECK(worst_overlap < 5 * rest + 0.01 * A);  // pressed only by its weight and the wall's push
   CHECK(o.max_speed < 1.1 * w_peak);
-  figure("4 mm fragment on a 1e13 N/m wall at 200 Hz",
-         "stable: largest gap " + num(worst_gap / A, 3) + " A, overlap " + num(worst_overlap / r, 3) +
-             " r, fastest " + num(o.max_speed / w_peak, 3) + " x wall peak speed over " + num(w.time(), 3) + " s");
+  figure(name, "stable: largest gap " + num(worst_gap / A, 3) + " A, overlap " + num(worst_overlap / r, 3) +
+                   " r, fastest " + num(o.max_speed / w_peak, 3) + " x wall peak speed over " + num(w.time(), 3) + " s");
+}
+
+}  // namespace
+
+TEST_CASE("light 4 mm fragment riding a 1e13 N/m wall that oscillates at 200 Hz", "[stability]") {
+  fragmentRidingWall(60000, "4 mm fragment on a 1e13 N/m wall at 200 Hz");
+}
+
+TEST_CASE("light 4 mm fragment riding a 1e13 N/m wall for 1e6 steps", "[stability][validation]") {
+  fragmentRidingWall(1000000, "4 mm fragment on a 1e13 N/m wall at 200 Hz, 1e6 steps");
 }
 
 TEST_CASE("a wall squeezing a 4 mm fragment against the floor is stopped by the overlap watchdog", "[stability]") {
