@@ -83,11 +83,11 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
   }
   std::vector<PairHistory> pairs;
   for (const PairHistory& h : state.pair_history)
-    if (keep[h.i] && keep[h.j]) pairs.push_back({new_index[h.i], new_index[h.j], h.shear});
+    if (keep[h.i] && keep[h.j]) pairs.push_back({new_index[h.i], new_index[h.j], h.shear, h.relax_offset});
   state.pair_history = std::move(pairs);
   std::vector<WallHistory> walls;
   for (const WallHistory& h : state.wall_history)
-    if (keep[h.particle]) walls.push_back({new_index[h.particle], h.wall, h.shear});
+    if (keep[h.particle]) walls.push_back({new_index[h.particle], h.wall, h.shear, h.relax_offset});
   state.wall_history = std::move(walls);
   return state;
 }

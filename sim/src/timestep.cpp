@@ -41,6 +41,11 @@ double linearContactTime(double mass, double k, double beta) {
   return std::numbers::pi / (std::sqrt(k / mass) * std::sqrt(1.0 - beta * beta));
 }
 
+double dampedStabilityLimit(double k, double c, double inv_mass) {
+  const double b = c * inv_mass;
+  return 4.0 / (b + std::sqrt(b * b + 4.0 * k * inv_mass));
+}
+
 double restitutionFromDamping(double beta) {
   return std::exp(-beta * std::numbers::pi / std::sqrt(1.0 - beta * beta));  // Eq 4-4
 }
@@ -64,7 +69,13 @@ std::string TimestepAudit::describe(const TimestepSettings& settings) const {
     s << "  linear contact time                  " << linear_contact_time << " s ("
       << linear_contact_time / chosen << " steps)\n";
   s << "  critical (min of springs)            " << critical << " s\n";
-  s << "  automatic = " << settings.safety_factor << " x critical        " << automatic << " s\n";
+  if (damped_limit > 0)
+    s << "  damped stability limit (dashpots)    " << damped_limit << " s\n";
+  if (automatic < settings.safety_factor * critical)
+    s << "  automatic = " << kDampedMargin << " x damped limit        " << automatic << " s (below "
+      << settings.safety_factor << " x critical: strong dashpots)\n";
+  else
+    s << "  automatic = " << settings.safety_factor << " x critical        " << automatic << " s\n";
   s << "  chosen dt                            " << chosen << " s  (dt/dt_crit = " << ratio()
     << (settings.dt > 0 ? ", set by timestep.dt" : ", automatic") << ")";
   return s.str();
@@ -82,6 +93,17 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
   std::vector<bool> ball_material(model.materials.size(), false);
   for (int m : particles.material) ball_material[m] = true;
   double lightest = inf, lightest_k = 0.0;
+  // Damped stability limit (see dampedStabilityLimit). Each ball's inverse masses
+  // of the normal and the sticking-shear mode at a contact: 1/m + e^2/I with e the
+  // lever of the force about the centre (0 normal, R shear for a sphere; clump
+  // members: their offset, and offset + R). Partners: a ball like this one, the
+  // lightest and the heaviest ball (the average-mass dashpot of a fragment on a
+  // rock is the hardest), or a wall (immovable, dashpot on the ball's mass).
+  const ContactModel& cm = model.contact;
+  const bool damped = cm.damping_normal > 0 || cm.damping_shear > 0;
+  double damped_limit = inf;
+  struct Body { double m, inv_n, inv_t; };
+  std::vector<Body> body(particles.size());
   double rayleigh = inf, hertz_time = inf;
 
   // Lever of a contact about the body's centre: the radius for a sphere, the
@@ -91,11 +113,33 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
   for (std::size_t m = 0; m < clumps.member_ball.size(); ++m)
     lever[clumps.member_ball[m]] += clumps.member_offset[m].norm();
 
+  std::size_t light = 0, heavy = 0;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const double m = particles.mass[i], r = particles.radius[i], inv_i = particles.inv_inertia[i];
+    const double offset = lever[i] - r;
+    body[i] = {m, 1.0 / m + offset * offset * inv_i, 1.0 / m + lever[i] * lever[i] * inv_i};
+    if (m < particles.mass[light]) light = i;
+    if (m > particles.mass[heavy]) heavy = i;
+  }
+  auto dampedModes = [&](double kn, double ks, const Body& self, const Body* b) {
+    const double inv_n = self.inv_n + (b ? b->inv_n : 0.0), inv_t = self.inv_t + (b ? b->inv_t : 0.0);
+    double md = self.m;  // ball–wall: the ball's mass (Eq 2-18)
+    if (b) md = cm.damping_mass == DampingMass::Average ? 0.5 * (self.m + b->m) : self.m * b->m / (self.m + b->m);
+    if (kn > 0) {
+      const double c = 2.0 * cm.damping_normal * std::sqrt(md * kn);
+      damped_limit = std::min(damped_limit, dampedStabilityLimit(kn, kDashpotMultiplicity * c, inv_n));
+    }
+    if (ks > 0) {
+      const double c = 2.0 * cm.damping_shear * std::sqrt(md * ks);
+      damped_limit = std::min(damped_limit, dampedStabilityLimit(ks, kDashpotMultiplicity * c, inv_t));
+    }
+  };
+
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const Material& mi = model.materials[particles.material[i]];
     const double m = particles.mass[i], r = particles.radius[i], arm = lever[i];
     const double inertia = 1.0 / particles.inv_inertia[i];
-    auto consider = [&](const PairProps& p, double m_star) {
+    auto consider = [&](const PairProps& p, double m_star, bool wall) {
       double kn = p.kn, ks = p.ks;
       if (hertz) {
         // Tangent stiffnesses at the deepest overlap of an impact at `v`.
@@ -107,14 +151,21 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
       }
       a.spring_translational = std::min(a.spring_translational, std::sqrt(m / kn));
       a.spring_rotational = std::min(a.spring_rotational, std::sqrt(inertia / (ks * arm * arm)));
+      if (damped) {
+        if (wall) {
+          dampedModes(kn, ks, body[i], nullptr);
+        } else {
+          for (std::size_t partner : {i, light, heavy}) dampedModes(kn, ks, body[i], &body[partner]);
+        }
+      }
       if (m < lightest || (m == lightest && kn > lightest_k)) {
         lightest = m;
         lightest_k = kn;
       }
     };
     for (std::size_t k = 0; k < model.materials.size(); ++k)
-      if (ball_material[k]) consider(detail::ballBallProps(mi, model.materials[k]), 0.5 * m);
-    for (const Wall& w : model.walls) consider(detail::ballWallProps(mi, model.materials[w.material]), m);
+      if (ball_material[k]) consider(detail::ballBallProps(mi, model.materials[k]), 0.5 * m, false);
+    for (const Wall& w : model.walls) consider(detail::ballWallProps(mi, model.materials[w.material]), m, true);
     if (mi.shear_modulus > 0)
       rayleigh = std::min(rayleigh, rayleighStep(r, mi.density, mi.shear_modulus, mi.poisson));
   }
@@ -134,14 +185,19 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
     a.critical = inf;
     return a;
   }
+  a.damped_limit = std::isfinite(damped_limit) ? damped_limit : 0.0;
   a.automatic = ts.safety_factor * a.critical;
+  // Strong dashpots shrink the stable step below the spring criterion (ref §7a):
+  // cap the automatic step at a margin below the exact damped limit.
+  if (a.damped_limit > 0) a.automatic = std::min(a.automatic, kDampedMargin * a.damped_limit);
   a.chosen = a.automatic;
   if (ts.dt > 0) {
     if (ts.dt > a.automatic * (1.0 + 1e-12) && !ts.allow_unsafe) {
       std::ostringstream s;
       s << "timestep.dt = " << ts.dt << " s is larger than the automatic step " << a.automatic
-        << " s (timestep.safety_factor " << ts.safety_factor << " x critical " << a.critical
-        << " s); a scene may only lower the step: set timestep.dt <= " << a.automatic
+        << " s (timestep.safety_factor " << ts.safety_factor << " x critical " << a.critical << " s"
+        << (a.automatic < ts.safety_factor * a.critical ? ", capped by the damped stability limit" : "")
+        << "); a scene may only lower the step: set timestep.dt <= " << a.automatic
         << " s, or timestep.allow_unsafe = true to force it";
       throw std::invalid_argument(s.str());
     }

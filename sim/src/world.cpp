@@ -87,6 +87,12 @@ struct World::Impl {
   std::vector<std::uint32_t> wall_index;   // [k]
   std::vector<Vec3> wall_shear;            // [k] N on the ball
   std::vector<std::uint8_t> wall_touch;    // [k]
+  // Relaxation of initial overlaps (Model::relaxation); empty when off or done.
+  std::vector<double> pair_relax;  // [pairs] m, initial overlap of the pair (offset at factor 1)
+  std::vector<double> wall_relax;  // [k] m, the same for ball–wall candidates
+  bool relax_pending = false;      // offsets still to be taken at the first step
+  double relax_factor = 0.0;       // offset / initial overlap at this step (1 -> 0, smoothstep)
+  bool relaxing() const { return !pair_relax.empty(); }
   // Per-ball force and torque accumulators (contacts only).
   std::vector<Vec3> acc_force, acc_torque;
   // Observation buffers (filled only on observed steps).
@@ -101,6 +107,11 @@ struct World::Impl {
   // Watchdog energy reference.
   bool energy_ref_valid = false;
   double energy_ref = 0.0, energy_scale = 0.0;
+  // Work done on each ball by moving walls since the energy reference (J), net
+  // and gross (sum of |dW|); empty when no wall moves. Per ball, so the sums do
+  // not depend on the number of threads.
+  std::vector<double> wall_work, wall_work_gross;
+  std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
 
   // Below this many balls per thread a second thread does not pay: a step of a
   // few thousand balls takes tens of microseconds, and waking the team, the
@@ -130,6 +141,8 @@ struct World::Impl {
   void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
   void checkEnergy(const Energy& e);
+  void startRelaxation();
+  void updateRelaxation();
   bool energyCheckApplies() const;
   std::string stepAdvice() const;
   void doStep(const std::function<void(const Snapshot&)>& observer);
@@ -142,6 +155,7 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
                           const std::vector<ClumpSpec>& clumps) {
   std::ostringstream e;
   if (model.materials.empty()) return "no materials defined";
+  if (model.relaxation.steps < 0) return "relaxation.steps must be >= 0";
   for (std::size_t k = 0; k < model.materials.size(); ++k) {
     const Material& m = model.materials[k];
     const std::string where = "material '" + m.name + "'";
@@ -280,6 +294,7 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vec
   w.audit = auditTimestep(w.model, p);
   w.dt = w.audit.chosen;
   w.initialise(threads);
+  w.relax_pending = w.model.relaxation.steps > 0;
 }
 
 World::World(Model model, WorldState state, int threads) : impl_(std::make_unique<Impl>()) {
@@ -305,6 +320,13 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
     if (it == e || *it != h.j)
       throw std::invalid_argument("checkpoint: contact history for a pair that is not in contact range");
     w.pair_shear[it - w.pairs.partner.begin()] = h.shear;
+    if (h.relax_offset > 0) {
+      if (w.pair_relax.empty()) {
+        w.pair_relax.assign(w.pairs.size(), 0.0);
+        w.wall_relax.assign(w.wall_index.size(), 0.0);
+      }
+      w.pair_relax[it - w.pairs.partner.begin()] = h.relax_offset;
+    }
   }
   for (const WallHistory& h : state.wall_history) {
     if (h.wall >= w.walls.size()) throw std::invalid_argument("checkpoint: wall contact history for a missing wall");
@@ -313,6 +335,13 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
     for (std::uint32_t c = w.wall_offset[h.particle]; c < w.wall_offset[h.particle + 1]; ++c)
       if (w.wall_index[c] == h.wall) {
         w.wall_shear[c] = h.shear;
+        if (h.relax_offset > 0) {
+          if (w.pair_relax.empty()) {
+            w.pair_relax.assign(w.pairs.size(), 0.0);
+            w.wall_relax.assign(w.wall_index.size(), 0.0);
+          }
+          w.wall_relax[c] = h.relax_offset;
+        }
         found = true;
       }
     if (!found)
@@ -328,6 +357,16 @@ void World::Impl::initialise(int requested_threads) {
   buildPairProps();
   walls.resize(model.walls.size());
   for (std::size_t k = 0; k < walls.size(); ++k) walls[k].setup(model.walls[k]);
+  wall_moving.assign(walls.size(), 0);
+  bool any_moving = false;
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    wall_moving[k] = model.walls[k].motion.isStatic() ? 0 : 1;
+    any_moving = any_moving || wall_moving[k];
+  }
+  if (any_moving) {
+    wall_work.assign(p.size(), 0.0);
+    wall_work_gross.assign(p.size(), 0.0);
+  }
   // Gravity in force at the current time.
   gravity = model.gravity;
   for (const GravityChange& g : model.gravity_changes)
@@ -384,10 +423,13 @@ void World::Impl::rebuildNeighbours() {
   const std::size_t n = p.size();
   detail::PairList old = std::move(pairs);
   std::vector<Vec3> old_shear = std::move(pair_shear);
+  std::vector<double> old_relax = std::move(pair_relax);
+  const bool relax = !old_relax.empty();
   finder.build(p.position, p.radius, skin, teamSize(), pairs, model.max_grid_levels, p.clump);
   const std::size_t np = pairs.size();
   pair_shear.assign(np, Vec3::Zero());
   pair_touch.assign(np, 0);
+  if (relax) pair_relax.assign(np, 0.0);
   // Carry shear history over by merging old and new rows (both sorted by j).
   if (!old.row_offset.empty()) {
 #pragma omp parallel for schedule(static) num_threads(teamSize())
@@ -397,13 +439,17 @@ void World::Impl::rebuildNeighbours() {
       while (a < ae && b < be) {
         if (old.partner[a] < pairs.partner[b]) ++a;
         else if (old.partner[a] > pairs.partner[b]) ++b;
-        else pair_shear[b++] = old_shear[a++];
+        else {
+          if (relax) pair_relax[b] = old_relax[a];
+          pair_shear[b++] = old_shear[a++];
+        }
       }
     }
   }
   // Wall candidates: balls within r + skin of an active wall.
   std::vector<std::uint32_t> old_offset = std::move(wall_offset), old_index = std::move(wall_index);
   std::vector<Vec3> old_wshear = std::move(wall_shear);
+  std::vector<double> old_wrelax = std::move(wall_relax);
   wall_offset.assign(n + 1, 0);
   wall_index.clear();
   for (std::size_t i = 0; i < n; ++i) {
@@ -416,11 +462,15 @@ void World::Impl::rebuildNeighbours() {
   }
   wall_shear.assign(wall_index.size(), Vec3::Zero());
   wall_touch.assign(wall_index.size(), 0);
+  if (relax) wall_relax.assign(wall_index.size(), 0.0);
   if (!old_offset.empty()) {
     for (std::size_t i = 0; i < n; ++i)
       for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c)
         for (std::uint32_t o = old_offset[i]; o < old_offset[i + 1]; ++o)
-          if (old_index[o] == wall_index[c]) wall_shear[c] = old_wshear[o];
+          if (old_index[o] == wall_index[c]) {
+            wall_shear[c] = old_wshear[o];
+            if (relax) wall_relax[c] = old_wrelax[o];
+          }
   }
   ref_position = p.position;
   for (auto& wr : walls) wr.setReference();
@@ -472,6 +522,7 @@ template <class Law>
   if (dist2 >= rsum * rsum) {
     pair_touch[k] = 0;
     pair_shear[k].setZero();
+    if (relaxing()) pair_relax[k] = 0.0;  // separated: a new touch gets the full force
     return false;
   }
   const double dist = std::sqrt(dist2);
@@ -479,6 +530,15 @@ template <class Law>
   g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
   g.overlap = rsum - dist;
   const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point: middle of the overlap
+  if (relaxing()) {
+    // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
+    g.overlap -= relax_factor * pair_relax[k];
+    if (g.overlap <= 0) {
+      pair_touch[k] = 0;
+      pair_shear[k].setZero();
+      return false;
+    }
+  }
   const Vec3 ai = cp - xi, aj = cp - p.position[j];
   g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
   g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
@@ -508,14 +568,24 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
     if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
       wall_touch[w] = 0;
       wall_shear[w].setZero();
+      if (relaxing()) wall_relax[w] = 0.0;
       continue;
     }
     detail::ContactGeometry g;
     g.normal = wc.normal;
     g.overlap = wc.overlap;
     const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
+    if (relaxing()) {
+      g.overlap -= relax_factor * wall_relax[w];
+      if (g.overlap <= 0) {
+        wall_touch[w] = 0;
+        wall_shear[w].setZero();
+        continue;
+      }
+    }
     const Vec3 ai = cp - xi;
-    g.rel_velocity = wr.velocityAt(cp) - (p.velocity[i] + p.omega[i].cross(ai));
+    const Vec3 v_wall = wr.velocityAt(cp);
+    g.rel_velocity = v_wall - (p.velocity[i] + p.omega[i].cross(ai));
     g.r_tilde = ri;            // mirror-image ball (ref §4.2)
     g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)
     const PairProps& props =
@@ -524,6 +594,12 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
     f += res.force;
     t += ai.cross(res.force);
     wall_touch[w] = 1;
+    if (!wall_work.empty() && wall_moving[wk]) {
+      // Power of the wall on the ball, F . v_wall (the energy watchdog's work input).
+      const double dw = dt * res.force.dot(v_wall);
+      wall_work[i] += dw;
+      wall_work_gross[i] += std::abs(dw);
+    }
     if (g.overlap > model.watchdog.max_overlap_fraction * ri)
       mergeWorst(c, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
   }
@@ -699,7 +775,8 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
       if (!pair_touch[k]) continue;
       const std::uint32_t j = pairs.partner[k];
       const double rsum = p.radius[i] + p.radius[j];
-      const double overlap = rsum - (p.position[j] - p.position[i]).norm();
+      double overlap = rsum - (p.position[j] - p.position[i]).norm();
+      if (relaxing()) overlap -= relax_factor * pair_relax[k];
       const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm +
                                          static_cast<std::size_t>(p.material[j])];
       e.elastic += detail::elasticEnergy<Law>(props, overlap, 2.0 * p.radius[i] * p.radius[j] / rsum,
@@ -712,7 +789,8 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
       if (!walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc)) continue;
       const PairProps& props = ball_wall[static_cast<std::size_t>(p.material[i]) * nm +
                                          static_cast<std::size_t>(model.walls[wk].material)];
-      e.elastic += detail::elasticEnergy<Law>(props, wc.overlap, p.radius[i], wall_shear[c]);
+      const double overlap = wc.overlap - (relaxing() ? relax_factor * wall_relax[c] : 0.0);
+      e.elastic += detail::elasticEnergy<Law>(props, overlap, p.radius[i], wall_shear[c]);
     }
   }
   return e;
@@ -751,7 +829,10 @@ void World::Impl::checkOverlap(const StepChecks& checks) const {
     s << " with particle " << p.id[low];
   s << " is " << fmtNum(checks.worst_overlap)
     << " of the smaller radius, above watchdog.max_overlap_fraction = "
-    << model.watchdog.max_overlap_fraction << ". Either the particles were created overlapping, or "
+    << model.watchdog.max_overlap_fraction
+    << ". Either the particles were created overlapping (relaxation.steps eases initial overlaps apart), "
+       "the contacts are too soft for the loads or impact speeds (a linear impact at v overlaps "
+       "v sqrt(m/k): stiffen them), or "
     << stepAdvice();
   throw WatchdogError(s.str());
 }
@@ -767,10 +848,60 @@ void World::Impl::checkFinite() const {
 }
 
 bool World::Impl::energyCheckApplies() const {
-  // With a moving wall, work comes in from outside: the check cannot tell.
-  for (std::size_t k = 0; k < walls.size(); ++k)
-    if (walls[k].active && !model.walls[k].motion.isStatic()) return false;
+  // Moving walls do work: it is counted (wall_work) and allowed for in checkEnergy.
+  // Relaxing initial overlaps does work on the system (the offsets shrink).
+  if (relaxing()) return false;
   return model.watchdog.max_energy_growth > 0 && p.size() > 0;
+}
+
+/// Takes every touching contact's overlap as its relaxation offset (first step
+/// of a world built with Model::relaxation.steps > 0).
+void World::Impl::startRelaxation() {
+  relax_pending = false;
+  pair_relax.assign(pairs.size(), 0.0);
+  wall_relax.assign(wall_index.size(), 0.0);
+  bool any = false;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::uint32_t k = pairs.row_offset[i]; k < pairs.row_offset[i + 1]; ++k) {
+      const std::uint32_t j = pairs.partner[k];
+      const double overlap = p.radius[i] + p.radius[j] - (p.position[j] - p.position[i]).norm();
+      if (overlap > 0) {
+        pair_relax[k] = overlap;
+        any = true;
+      }
+    }
+    for (std::uint32_t c = wall_offset[i]; c < wall_offset[i + 1]; ++c) {
+      const std::uint32_t wk = wall_index[c];
+      detail::WallContact wc;
+      if (walls[wk].active && walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc) &&
+          wc.overlap > 0) {
+        wall_relax[c] = wc.overlap;
+        any = true;
+      }
+    }
+  }
+  if (!any) {
+    pair_relax.clear();
+    wall_relax.clear();
+  }
+}
+
+/// Offset factor of this step; frees the offsets once the relaxation is over.
+void World::Impl::updateRelaxation() {
+  const auto n = static_cast<std::uint64_t>(std::max(0, model.relaxation.steps));
+  if (step >= n) {
+    pair_relax.clear();
+    pair_relax.shrink_to_fit();
+    wall_relax.clear();
+    wall_relax.shrink_to_fit();
+    energy_ref_valid = false;  // the energy check starts afresh from the relaxed state
+    return;
+  }
+  // Smoothstep: the offset starts and ends shrinking at zero rate, so the bodies
+  // are not jerked into motion at the start nor left moving at the end (a linear
+  // ramp leaves them with up to twice its rate). Peak rate 1.5 x offset / (n dt).
+  const double x = static_cast<double>(step) / static_cast<double>(n);
+  relax_factor = 1.0 - x * x * (3.0 - 2.0 * x);
 }
 
 void World::Impl::checkEnergy(const Energy& e) {
@@ -791,18 +922,30 @@ void World::Impl::checkEnergy(const Energy& e) {
     energy_scale = std::abs(e.kinetic_translational + e.kinetic_rotational + e.elastic) +
                    mass * gravity.norm() * extent;
     energy_ref_valid = energy_scale > 0;
+    std::fill(wall_work.begin(), wall_work.end(), 0.0);
+    std::fill(wall_work_gross.begin(), wall_work_gross.end(), 0.0);
     return;
   }
-  const double growth = e.total() - energy_ref;
-  if (growth <= model.watchdog.max_energy_growth * energy_scale) return;
+  // Work of the moving walls since the reference, summed in ball order. The
+  // allowance grows with the gross work so that the O(dt^2) error of counting it
+  // cannot add up to a false alarm in a long run with a working wall (a crusher).
+  double work = 0.0, gross = 0.0;
+  for (std::size_t i = 0; i < wall_work.size(); ++i) {
+    work += wall_work[i];
+    gross += wall_work_gross[i];
+  }
+  const double growth = e.total() - energy_ref - work;
+  if (growth <= model.watchdog.max_energy_growth * (energy_scale + gross)) return;
   std::size_t fastest = 0;
   for (std::size_t i = 1; i < p.size(); ++i)
     if (p.velocity[i].squaredNorm() > p.velocity[fastest].squaredNorm()) fastest = i;
   std::ostringstream s;
   s << "watchdog: mechanical energy grew by " << fmtNum(growth) << " J (" << fmtNum(growth / energy_scale)
     << " of its scale " << fmtNum(energy_scale) << " J, limit watchdog.max_energy_growth = "
-    << model.watchdog.max_energy_growth << ") at t = " << fmtNum(time) << " s (step " << step
-    << ") with no work input; fastest particle " << p.id[fastest] << " at "
+    << model.watchdog.max_energy_growth << ") at t = " << fmtNum(time) << " s (step " << step << ") "
+    << (wall_work.empty() ? std::string("with no work input")
+                          : "beyond the " + fmtNum(work) + " J of work done by the moving walls")
+    << "; fastest particle " << p.id[fastest] << " at "
     << fmtNum(p.velocity[fastest].norm()) << " m/s. " << stepAdvice();
   throw WatchdogError(s.str());
 }
@@ -814,6 +957,8 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   const std::size_t n = p.size();
   prepareStage();                                     // 1
   if (need_rebuild) rebuildNeighbours();              // 2
+  if (relax_pending) startRelaxation();
+  if (relaxing()) updateRelaxation();
   const double h = half_kick_pending ? 0.5 * dt : dt;
   const int interval = std::max(1, model.watchdog.check_interval);
   const bool energy_due = (step % static_cast<std::uint64_t>(interval)) == 0 && energyCheckApplies();
@@ -924,12 +1069,14 @@ WorldState World::exportState() const {
   s.particles = w.p;
   for (std::size_t i = 0; i + 1 < w.pairs.row_offset.size(); ++i)
     for (std::uint32_t k = w.pairs.row_offset[i]; k < w.pairs.row_offset[i + 1]; ++k)
-      if (!w.pair_shear[k].isZero(0))
-        s.pair_history.push_back({static_cast<std::uint32_t>(i), w.pairs.partner[k], w.pair_shear[k]});
+      if (!w.pair_shear[k].isZero(0) || (w.relaxing() && w.pair_relax[k] > 0))
+        s.pair_history.push_back({static_cast<std::uint32_t>(i), w.pairs.partner[k], w.pair_shear[k],
+                                  w.relaxing() ? w.pair_relax[k] : 0.0});
   for (std::size_t i = 0; i + 1 < w.wall_offset.size(); ++i)
     for (std::uint32_t c = w.wall_offset[i]; c < w.wall_offset[i + 1]; ++c)
-      if (!w.wall_shear[c].isZero(0))
-        s.wall_history.push_back({static_cast<std::uint32_t>(i), w.wall_index[c], w.wall_shear[c]});
+      if (!w.wall_shear[c].isZero(0) || (w.relaxing() && w.wall_relax[c] > 0))
+        s.wall_history.push_back({static_cast<std::uint32_t>(i), w.wall_index[c], w.wall_shear[c],
+                                  w.relaxing() ? w.wall_relax[c] : 0.0});
   return s;
 }
 

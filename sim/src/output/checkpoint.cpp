@@ -121,6 +121,10 @@ void writeHistory(const H5::Group& root, const HistoryLayout<History>& layout,
   writeArray(group, layout.first_name, column(rows, layout.first), "");
   writeArray(group, layout.second_name, column(rows, layout.second), "");
   writeArray(group, "shear", column(rows, &History::shear), "N");
+  // Only while initial overlaps are being relaxed (Model::relaxation).
+  bool relaxing = false;
+  for (const History& row : rows) relaxing = relaxing || row.relax_offset != 0.0;
+  if (relaxing) writeArray(group, "relax_offset", column(rows, &History::relax_offset), "m");
 }
 
 void writeParticles(const H5::Group& root, const ParticleState& p) {
@@ -286,6 +290,11 @@ std::vector<History> readHistory(const Reader& in, const HistoryLayout<History>&
     rows[k].*layout.first = first[k];
     rows[k].*layout.second = second[k];
     rows[k].shear = shear[k];
+  }
+  if (in.has(group + "relax_offset")) {
+    const auto offset = in.array<double>(group + "relax_offset");
+    if (offset.size() != first.size()) in.fail("inconsistent array sizes in " + group + ": relax_offset");
+    for (std::size_t k = 0; k < rows.size(); ++k) rows[k].relax_offset = offset[k];
   }
   return rows;
 }

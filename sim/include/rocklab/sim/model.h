@@ -90,6 +90,24 @@ struct WatchdogSettings {
   int check_interval = 100;           // steps between energy checks
 };
 
+/// Relaxation of the overlaps a World starts with ("freeze" in the spirit of the
+/// study's procedure, experiments.md §g, but only its overlap part): balls created
+/// overlapping — fragments placed by breakage replacement overlap their
+/// neighbours by up to half a radius — would otherwise release the artificial
+/// elastic energy of that overlap within one contact period (a fragment at
+/// 1e9 N/m leaves at hundreds of m/s). With `steps` > 0 every contact that
+/// touches when the World is built from spheres/clumps keeps its initial overlap
+/// as an offset that shrinks to zero over `steps` steps (smoothstep in time: no
+/// jerk at either end, peak rate 1.5 x offset / (steps dt)); the contact law
+/// sees (overlap - offset) and pushes only when that is > 0, so the bodies are
+/// eased apart and the stored energy is never released. Contacts made later are
+/// untouched; a pair that separates loses its offset. While relaxing, the energy
+/// watchdog is suspended (the shrinking offset does work) and the overlap
+/// watchdog measures the overlap beyond the offset. 0 = off (default).
+struct OverlapRelaxation {
+  int steps = 0;  // steps over which initial overlaps are relaxed; 0 = off
+};
+
 struct Model {
   std::vector<Material> materials;
   ContactModel contact;
@@ -98,6 +116,7 @@ struct Model {
   std::vector<GravityChange> gravity_changes;           // sorted by time
   TimestepSettings timestep;
   WatchdogSettings watchdog;
+  OverlapRelaxation relaxation;
   double skin = 0.0;  // m  Verlet skin; 0 = 0.2 x mean radius
   int max_grid_levels = 8;  // neighbour grid levels (one per doubling of the radius); 1 = plain grid
 };

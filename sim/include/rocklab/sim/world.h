@@ -41,11 +41,13 @@ struct WatchdogError : std::runtime_error {
 struct PairHistory {
   std::uint32_t i = 0, j = 0;
   Vec3 shear = Vec3::Zero();  // N, shear spring force on i
+  double relax_offset = 0.0;  // m, initial overlap still being relaxed (Model::relaxation)
 };
 /// Contact history of one ball–wall contact.
 struct WallHistory {
   std::uint32_t particle = 0, wall = 0;
   Vec3 shear = Vec3::Zero();  // N, shear spring force on the ball
+  double relax_offset = 0.0;  // m, initial overlap still being relaxed (Model::relaxation)
 };
 
 /// Everything that changes during a run: with the Model it restarts a run bit
