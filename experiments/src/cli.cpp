@@ -4,6 +4,7 @@
 #include <csignal>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "rocklab/experiments/render_run.h"
 #include "rocklab/experiments/run.h"
@@ -30,11 +31,16 @@ Examples:
   rocklab calibrate heap --vary materials.pebble.friction=0.2,0.3,0.4,0.5 --target angle_of_repose_deg=26.03
   rocklab sweep chute-30-clumps --vary experiment.inclination_deg=27,30,33   # one table + plot
   rocklab study drop-timestep                    # built-in study: error of restitution against run time
+  rocklab study drop-timestep --plan runs/dt     # run list + Slurm script, nothing run; then:
+  parallel --jobs 2 < runs/dt/runs.txt && rocklab collect runs/dt
   rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
 
 Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
-watchdog, 130 interrupted by Ctrl-C (outputs so far are kept and readable).
+watchdog, 4 a sweep or study finished but some runs failed (see its table),
+130 interrupted by Ctrl-C (outputs so far are kept and readable).
+Sweeps and studies run each variant as its own process of one thread, one per
+core (--jobs N; --jobs 0 runs them here one after the other with --threads).
 Units are SI everywhere (m, s, kg, N, Pa).)";
 
 extern "C" void onSigint(int) {
@@ -86,6 +92,9 @@ int runCli(int argc, const char* const* argv) {
   auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
   run->add_option("scene", scene_arg, "Scene TOML file or built-in name (see `rocklab list`)")->required();
   addRunOptions(run);
+  bool skip_complete = false;
+  run->add_flag("--skip-complete", skip_complete,
+                "Do nothing when --out already holds a completed run (results.json status \"completed\")");
   auto* demo = app.add_subcommand("demo", "Run the default demo scene end to end");
   addRunOptions(demo);
   auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
@@ -103,6 +112,21 @@ int runCli(int argc, const char* const* argv) {
   std::vector<std::string> vary, metrics;
   std::string target;
   int iterations = 8;
+  int jobs = -1;
+  std::string plan_dir;
+  SweepOptions::Slurm slurm;
+  auto addSetOptions = [&](CLI::App* c) {
+    c->add_option("--jobs", jobs,
+                  "Runs at once, each its own process of one thread (default: one per core); 0 = one after the "
+                  "other in this process, each with --threads")
+        ->check(CLI::NonNegativeNumber);
+    c->add_option("--plan", plan_dir,
+                  "Write the run list (runs.txt), a Slurm array script and a README into DIR and run nothing; "
+                  "`rocklab collect DIR` merges the runs afterwards");
+    c->add_option("--slurm-time", slurm.time, "Slurm time limit per run (with --plan)")->capture_default_str();
+    c->add_option("--slurm-mem", slurm.memory, "Slurm memory per run (with --plan)")->capture_default_str();
+    c->add_option("--slurm-partition", slurm.partition, "Slurm partition (with --plan; default: the cluster's)");
+  };
   auto addSweepOptions = [&](CLI::App* c) {
     c->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
     c->add_option("--vary", vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
@@ -111,6 +135,7 @@ int runCli(int argc, const char* const* argv) {
   auto* sweep = app.add_subcommand("sweep", "Run a scene for every combination of --vary values; writes sweep.csv and sweep.png");
   addSweepOptions(sweep);
   sweep->add_option("--metric", metrics, "results.json figure to tabulate, dotted path (default: the experiment's)");
+  addSetOptions(sweep);
   auto* calibrate = app.add_subcommand(
       "calibrate", "Find the value of one key that gives a target figure (list: interpolate; lo:hi range: bisect)");
   addSweepOptions(calibrate);
@@ -128,6 +153,11 @@ int runCli(int argc, const char* const* argv) {
   study->add_option("--tolerance", tolerance, "error (%) the recommended variant may have (default 5)")
       ->check(CLI::PositiveNumber);
   addRunOptions(study);
+  addSetOptions(study);
+  std::string collect_dir;
+  auto* collect = app.add_subcommand("collect", "Merge the finished runs of a sweep or study folder into its table, "
+                                                "plot and recommendation (failed and missing runs listed)");
+  collect->add_option("dir", collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
 
   try {
     app.parse(argc, argv);
@@ -143,6 +173,7 @@ int runCli(int argc, const char* const* argv) {
   }
 
   if (app.got_subcommand("list")) return doList();
+  if (app.got_subcommand("collect")) return collectSet(collect_dir, std::cerr);
   if (app.got_subcommand("render")) return renderRun({checkpoint_arg, camera_file, out_dir}, std::cerr);
   if (app.got_subcommand("study")) {
     std::signal(SIGINT, onSigint);
@@ -166,7 +197,12 @@ int runCli(int argc, const char* const* argv) {
           throw std::invalid_argument("--reference '" + reference + "': give finest or a number (a lab value)");
       }
       if (tolerance > 0) so.tolerance_pct = tolerance;
-      so.runs.out_dir = out_dir;
+      so.runs.jobs = jobs;
+      so.runs.slurm = slurm;
+      so.runs.plan_only = !plan_dir.empty();
+      if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
+        throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
+      so.runs.out_dir = plan_dir.empty() ? out_dir : plan_dir;
       so.runs.threads = threads;
       so.runs.progress = !quiet;
       return runStudy(so, std::cerr);
@@ -186,7 +222,15 @@ int runCli(int argc, const char* const* argv) {
     std::signal(SIGINT, onSigint);
     try {
       for (const std::string& v : vary) so.vary.push_back(parseVary(v));
-      if (app.got_subcommand("sweep")) return runSweep(so, std::cerr);
+      if (app.got_subcommand("sweep")) {
+        so.jobs = jobs;
+        so.slurm = slurm;
+        so.plan_only = !plan_dir.empty();
+        if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
+          throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
+        if (!plan_dir.empty()) so.out_dir = plan_dir;
+        return runSweep(so, std::cerr);
+      }
       CalibrateOptions co;
       co.sweep = so;
       co.iterations = iterations;
@@ -240,6 +284,14 @@ int runCli(int argc, const char* const* argv) {
   }
 
   options.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(out_dir);
+  if (skip_complete) {
+    std::ifstream in(options.out_dir / "results.json");
+    const nlohmann::json r = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+    if (r.is_object() && r.value("status", "") == "completed") {
+      std::cerr << "rocklab: " << (options.out_dir / "results.json").string() << " is complete; not run again\n";
+      return kExitOk;
+    }
+  }
   std::signal(SIGINT, onSigint);
   const int code = runScene(scene, options, std::cerr);
   std::signal(SIGINT, SIG_DFL);

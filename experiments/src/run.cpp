@@ -89,6 +89,7 @@ class Progress {
 }  // namespace
 
 void requestStop() { g_stop = true; }
+bool stopRequested() { return g_stop; }
 
 int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   const auto t_start = Clock::now();

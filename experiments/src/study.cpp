@@ -11,7 +11,9 @@
 
 #include "atomic_file.h"
 #include "plot.h"
+#include "run_plan.h"
 #include "run_set.h"
+#include "study_report.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "toml_reader.h"
@@ -131,6 +133,80 @@ StudyAnalysis analyseStudy(std::vector<StudyPoint> points, std::optional<double>
   return a;
 }
 
+namespace {
+
+/// The study's table, study.json, plot and recommendation from what its runs left.
+int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const std::vector<PlannedRun>& runs,
+                const std::string& name, std::ostream& log) {
+  std::vector<StudyPoint> points;
+  std::vector<std::string> status;
+  bool all_ok = true;
+  for (const PlannedRun& r : runs) {
+    std::string error;
+    const Variant v = inspectRun(dir, r, &error);
+    StudyPoint p;
+    p.values = v.values;
+    p.figure = number(lookup(v.results, o.figure));
+    p.wall_s = number(lookup(v.results, "wall_time_s.total"));
+    p.ok = v.code == kExitOk && std::isfinite(p.figure);
+    points.push_back(p);
+    status.push_back(v.code != kExitOk ? failureStatus(v.code, error) : p.ok ? "ok" : "no figure");
+    all_ok = all_ok && v.code == kExitOk;
+  }
+  const StudyAnalysis a = analyseStudy(points, o.reference, o.tolerance_pct);
+  const std::string reference_text =
+      o.reference ? "the reference value " + fixed(a.reference, 6) : "the finest variant (" + fixed(a.reference, 6) + ")";
+
+  std::vector<std::string> header;
+  for (const auto& [key, values] : o.runs.vary) header.push_back(key);
+  header.push_back(o.figure);
+  for (const char* h : {"error", "error_pct", "wall_time_s", "pareto", "reference", "status"}) header.push_back(h);
+  std::vector<std::vector<std::string>> rows;
+  json rows_json = json::array();
+  for (std::size_t k = 0; k < a.points.size(); ++k) {
+    const StudyPoint& p = a.points[k];
+    std::vector<std::string> row = p.values;
+    for (const std::string& c : {fixed(p.figure, 8), fixed(p.error, 4), fixed(p.error_pct, 4), fixed(p.wall_s, 4),
+                                 std::string(p.pareto ? "yes" : ""), std::string(p.is_reference ? "yes" : ""), status[k]})
+      row.push_back(c);
+    rows.push_back(row);
+    json values = json::object();
+    for (std::size_t j = 0; j < p.values.size(); ++j) values[o.runs.vary[j].first] = p.values[j];
+    rows_json.push_back({{"values", values},
+                         {"folder", "runs/" + runs[k].name},
+                         {"figure", std::isfinite(p.figure) ? json(p.figure) : json(nullptr)},
+                         {"error", std::isfinite(p.error) ? json(p.error) : json(nullptr)},
+                         {"error_pct", std::isfinite(p.error_pct) ? json(p.error_pct) : json(nullptr)},
+                         {"wall_time_s", std::isfinite(p.wall_s) ? json(p.wall_s) : json(nullptr)},
+                         {"pareto", p.pareto},
+                         {"reference", p.is_reference},
+                         {"status", status[k]}});
+  }
+  writeTable(header, rows, dir / "study.csv", log);
+  const std::string line = recommendation(o, a, reference_text);
+  log << "recommendation: " << line << "\n";
+  json out = {{"scene", name},
+              {"description", o.description},
+              {"figure", o.figure},
+              {"reference", {{"kind", o.reference ? "value" : "finest"},
+                             {"value", std::isfinite(a.reference) ? json(a.reference) : json(nullptr)}}},
+              {"tolerance_pct", o.tolerance_pct},
+              {"variants", rows_json},
+              {"recommended", a.recommended ? json("runs/" + runs[*a.recommended].name) : json(nullptr)},
+              {"recommendation", line},
+              {"complete", all_ok}};
+  writeAtomically(dir / "study.json", out.dump(2) + "\n");
+  try {
+    writeStudyPlot(o, a, name, dir / "study.png");
+  } catch (const std::exception& e) {
+    log << "study: no plot (" << e.what() << ")\n";
+  }
+  log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << "\n";
+  return all_ok ? kExitOk : kExitRunsFailed;
+}
+
+}  // namespace
+
 int runStudy(const StudyOptions& o, std::ostream& log) {
   if (o.runs.vary.empty()) {
     log << "error: study: give at least one --vary key=a,b,c (from the cheapest to the finest value)\n";
@@ -140,87 +216,49 @@ int runStudy(const StudyOptions& o, std::ostream& log) {
     log << "error: study: give --figure, a results.json path such as restitution or tracking.rms_error_pct\n";
     return kExitBadInput;
   }
-  std::vector<Variant> variants = expandVariants(o.runs);
-  Scene first;
-  try {
-    for (const Variant& v : variants) first = sceneFor(o.runs, v.values);  // every scene valid before any run
-    first = sceneFor(o.runs, variants.front().values);
-  } catch (const SceneError& e) {
-    log << "error: " << e.what() << "\n";
+  // Validated before anything runs: an invalid variant is listed as failed (exit
+  // 2) and costs nothing; when none is valid, nothing is written.
+  const std::vector<PlannedRun> runs = planRuns(o.runs);
+  const auto valid = std::find_if(runs.begin(), runs.end(), [](const PlannedRun& r) { return r.invalid.empty(); });
+  if (valid == runs.end()) {
+    log << "error: " << runs.front().invalid << "\n";
     return kExitBadInput;
   }
+  const Scene first = sceneFor(o.runs, valid->values);
   const std::filesystem::path dir = outDirFor(o.runs, first, "-study");
-  std::filesystem::create_directories(dir);
-  log << "study of " << first.run.name << ": " << o.figure << " for " << variants.size() << " variants into "
+  json what = {{"kind", "study"},
+               {"figure", o.figure},
+               {"reference", o.reference ? json(*o.reference) : json("finest")},
+               {"tolerance_pct", o.tolerance_pct},
+               {"description", o.description}};
+  writePlanFiles(dir, o.runs, runs, what);
+  log << "study of " << first.run.name << ": " << o.figure << " for " << runs.size() << " variants into "
       << dir.string() << "\n";
   if (!o.description.empty()) log << "  " << o.description << "\n";
-  int code = kExitOk;
-  std::vector<StudyPoint> points;
-  for (std::size_t k = 0; k < variants.size(); ++k) {
-    runVariant(o.runs, dir / variantFolder(k), variants[k], log);
-    StudyPoint p;
-    p.values = variants[k].values;
-    p.figure = number(lookup(variants[k].results, o.figure));
-    p.wall_s = number(lookup(variants[k].results, "wall_time_s.total"));
-    p.ok = variants[k].code == kExitOk && std::isfinite(p.figure);
-    points.push_back(p);
-    if (variants[k].code == kExitInterrupted) {
-      code = kExitInterrupted;
-      break;
-    }
+  if (o.runs.plan_only) {
+    log << "study: planned, nothing run: " << (dir / "runs.txt").string() << " (see " << (dir / "README.md").string()
+        << "); afterwards: rocklab collect " << dir.string() << "\n";
+    return kExitOk;
   }
-  const StudyAnalysis a = analyseStudy(points, o.reference, o.tolerance_pct);
-  const std::string reference_text =
-      o.reference ? "the reference value " + fixed(a.reference, 6) : "the finest variant (" + fixed(a.reference, 6) + ")";
-
-  std::vector<std::string> header;
-  for (const auto& [key, values] : o.runs.vary) header.push_back(key);
-  for (const char* h : {"error", "error_pct", "wall_time_s", "pareto", "reference", "status"}) header.push_back(h);
-  header.insert(header.begin() + static_cast<std::ptrdiff_t>(o.runs.vary.size()), o.figure);
-  std::vector<std::vector<std::string>> rows;
-  json rows_json = json::array();
-  for (std::size_t k = 0; k < a.points.size(); ++k) {
-    const StudyPoint& p = a.points[k];
-    std::vector<std::string> row = p.values;
-    const std::string status = variants[k].code == kExitOk ? (p.ok ? "ok" : "no figure") : "exit " + std::to_string(variants[k].code);
-    for (const std::string& c : {fixed(p.figure, 8), fixed(p.error, 4), fixed(p.error_pct, 4), fixed(p.wall_s, 4),
-                                 std::string(p.pareto ? "yes" : ""), std::string(p.is_reference ? "yes" : ""), status})
-      row.push_back(c);
-    rows.push_back(row);
-    json values = json::object();
-    for (std::size_t j = 0; j < p.values.size(); ++j) values[o.runs.vary[j].first] = p.values[j];
-    rows_json.push_back({{"values", values},
-                         {"folder", variantFolder(k)},
-                         {"figure", std::isfinite(p.figure) ? json(p.figure) : json(nullptr)},
-                         {"error", std::isfinite(p.error) ? json(p.error) : json(nullptr)},
-                         {"error_pct", std::isfinite(p.error_pct) ? json(p.error_pct) : json(nullptr)},
-                         {"wall_time_s", std::isfinite(p.wall_s) ? json(p.wall_s) : json(nullptr)},
-                         {"pareto", p.pareto},
-                         {"reference", p.is_reference},
-                         {"status", status}});
-  }
-  writeTable(header, rows, dir / "study.csv", log);
-  const std::string line = recommendation(o, a, reference_text);
-  log << "recommendation: " << line << "\n";
-  json out = {{"scene", first.run.name},
-              {"description", o.description},
-              {"figure", o.figure},
-              {"reference", {{"kind", o.reference ? "value" : "finest"},
-                             {"value", std::isfinite(a.reference) ? json(a.reference) : json(nullptr)}}},
-              {"tolerance_pct", o.tolerance_pct},
-              {"variants", rows_json},
-              {"recommended", a.recommended ? json(variantFolder(*a.recommended)) : json(nullptr)},
-              {"recommendation", line},
-              {"complete", code == kExitOk}};
-  detail::writeAtomically(dir / "study.json", out.dump(2) + "\n");
-  try {
-    writeStudyPlot(o, a, first.run.name, dir / "study.png");
-  } catch (const std::exception& e) {
-    log << "study: no plot (" << e.what() << ")\n";
-  }
-  log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << "\n";
-  return code;
+  const int code = executeRuns(dir, o.runs, runs, log);
+  const int report = reportStudy(dir, o, runs, first.run.name, log);
+  return code != kExitOk ? code : report;
 }
+
+namespace detail {
+
+int collectStudy(const std::filesystem::path& dir, const SweepOptions& runs_options, const json& plan,
+                 const std::vector<PlannedRun>& runs, std::ostream& log) {
+  StudyOptions o;
+  o.runs = runs_options;
+  o.figure = plan.value("figure", "");
+  if (plan.contains("reference") && plan["reference"].is_number()) o.reference = plan["reference"].get<double>();
+  o.tolerance_pct = plan.value("tolerance_pct", o.tolerance_pct);
+  o.description = plan.value("description", "");
+  return reportStudy(dir, o, runs, std::filesystem::path(o.runs.scene).stem().string(), log);
+}
+
+}  // namespace detail
 
 std::filesystem::path builtinStudyDir() { return std::filesystem::path(ROCKLAB_ASSET_DIR) / "studies"; }
 

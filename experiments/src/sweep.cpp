@@ -1,5 +1,6 @@
 #include "rocklab/experiments/sweep.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -11,7 +12,9 @@
 
 #include "atomic_file.h"
 #include "plot.h"
+#include "run_plan.h"
 #include "run_set.h"
+#include "study_report.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 
@@ -34,18 +37,23 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   return m;
 }
 
-/// The sweep's table: the varied values, the chosen figures, how each run ended.
+/// The sweep's table: the varied values, the chosen figures, how each run ended
+/// (`status`: one per point; empty = "ok" or "exit N" from the point's code).
 void writeMetricTable(const SweepOptions& o, const std::vector<std::string>& metrics, const std::vector<Variant>& points,
-                      const std::filesystem::path& csv_path, std::ostream& log) {
+                      const std::filesystem::path& csv_path, std::ostream& log,
+                      const std::vector<std::string>& status = {}) {
   std::vector<std::string> header;
   for (const auto& [key, values] : o.vary) header.push_back(key);
   for (const auto& m : metrics) header.push_back(m);
   header.push_back("status");
   std::vector<std::vector<std::string>> rows;
-  for (const Variant& p : points) {
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Variant& p = points[k];
     std::vector<std::string> row = p.values;
     for (const auto& m : metrics) row.push_back(cell(lookup(p.results, m)));
-    row.push_back(p.code == kExitOk ? "ok" : "exit " + std::to_string(p.code));
+    row.push_back(k < status.size() && !status[k].empty() ? status[k]
+                  : p.code == kExitOk                     ? "ok"
+                                                          : "exit " + std::to_string(p.code));
     rows.push_back(row);
   }
   writeTable(header, rows, csv_path, log);
@@ -75,40 +83,24 @@ std::pair<std::string, std::vector<std::string>> parseVary(const std::string& as
   return {assignment.substr(0, eq), values};
 }
 
-int runSweep(const SweepOptions& o, std::ostream& log) {
-  if (o.vary.empty()) {
-    log << "error: sweep: give at least one --vary key=a,b,c\n";
-    return kExitBadInput;
-  }
-  // Every combination, the first key slowest; each scene is loaded (validated)
-  // before anything runs, so a bad value costs nothing.
-  std::vector<Variant> points = expandVariants(o);
-  Scene first;
-  try {
-    for (const Variant& p : points) first = sceneFor(o, p.values);
-    first = sceneFor(o, points.front().values);
-  } catch (const SceneError& e) {
-    log << "error: " << e.what() << "\n";
-    return kExitBadInput;
-  }
-  const std::vector<std::string> metrics = o.metrics.empty() ? defaultMetrics(first) : o.metrics;
-  const std::filesystem::path dir = outDirFor(o, first, "-sweep");
-  std::filesystem::create_directories(dir);
-  log << "sweep of " << first.run.name << ": " << points.size() << " runs into " << dir.string() << "\n";
-  int code = kExitOk;
+namespace {
+
+/// The sweep's table and plot from what its runs left (in-process, processes or collect).
+int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const std::vector<std::string>& metrics,
+                const std::vector<PlannedRun>& runs, const std::string& name, std::ostream& log) {
   std::vector<Variant> done;
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    runVariant(o, dir / variantFolder(k), points[k], log);
-    done.push_back(points[k]);
-    if (points[k].code == kExitInterrupted) {
-      code = kExitInterrupted;
-      break;
-    }
+  std::vector<std::string> status;
+  bool all_ok = true;
+  for (const PlannedRun& r : runs) {
+    std::string error;
+    done.push_back(inspectRun(dir, r, &error));
+    status.push_back(done.back().code == kExitOk ? "ok" : failureStatus(done.back().code, error));
+    all_ok = all_ok && done.back().code == kExitOk;
   }
-  writeMetricTable(o, metrics, done, dir / "sweep.csv", log);
+  writeMetricTable(o, metrics, done, dir / "sweep.csv", log, status);
   // Plot: the first metric against the first key; one series per value of the second key.
   PlotSpec spec;
-  spec.title = first.run.name + ": " + metrics.front() + " against " + o.vary.front().first;
+  spec.title = name + ": " + metrics.front() + " against " + o.vary.front().first;
   spec.x_label = o.vary.front().first;
   spec.y_label = metrics.front();
   const std::size_t groups = o.vary.size() > 1 ? o.vary[1].second.size() : 1;
@@ -132,7 +124,69 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
     log << "sweep: no plot (" << e.what() << ")\n";
   }
   log << "sweep: table " << (dir / "sweep.csv").string() << ", plot " << (dir / "sweep.png").string() << "\n";
-  return code;
+  return all_ok ? kExitOk : kExitRunsFailed;
+}
+
+}  // namespace
+
+int runSweep(const SweepOptions& o, std::ostream& log) {
+  if (o.vary.empty()) {
+    log << "error: sweep: give at least one --vary key=a,b,c\n";
+    return kExitBadInput;
+  }
+  // Every combination, the first key slowest, validated before anything runs: an
+  // invalid variant is listed as failed (exit 2) and costs nothing; when none is
+  // valid, nothing is written.
+  const std::vector<PlannedRun> runs = planRuns(o);
+  const auto valid = std::find_if(runs.begin(), runs.end(), [](const PlannedRun& r) { return r.invalid.empty(); });
+  if (valid == runs.end()) {
+    log << "error: " << runs.front().invalid << "\n";
+    return kExitBadInput;
+  }
+  const Scene first = sceneFor(o, valid->values);
+  const std::vector<std::string> metrics = o.metrics.empty() ? defaultMetrics(first) : o.metrics;
+  const std::filesystem::path dir = outDirFor(o, first, "-sweep");
+  writePlanFiles(dir, o, runs, {{"kind", "sweep"}, {"metrics", metrics}});
+  log << "sweep of " << first.run.name << ": " << runs.size() << " runs into " << dir.string() << "\n";
+  if (o.plan_only) {
+    log << "sweep: planned, nothing run: " << (dir / "runs.txt").string() << " (see " << (dir / "README.md").string()
+        << "); afterwards: rocklab collect " << dir.string() << "\n";
+    return kExitOk;
+  }
+  const int code = executeRuns(dir, o, runs, log);
+  const int report = reportSweep(dir, o, metrics, runs, first.run.name, log);
+  return code != kExitOk ? code : report;
+}
+
+int collectSet(const std::filesystem::path& dir, std::ostream& log) {
+  std::ifstream in(dir / "plan.json");
+  const json plan = in ? json::parse(in, nullptr, false) : json();
+  if (!plan.is_object() || !plan.contains("runs")) {
+    log << "error: collect: " << (dir / "plan.json").string()
+        << " is missing or unreadable; give the folder of a sweep or study (made with --plan or --jobs)\n";
+    return kExitBadInput;
+  }
+  SweepOptions o;
+  o.scene = plan.value("scene", "");
+  o.overrides = plan.value("overrides", std::vector<std::string>{});
+  for (const json& v : plan["vary"]) o.vary.emplace_back(v["key"].get<std::string>(), v["values"].get<std::vector<std::string>>());
+  std::vector<PlannedRun> runs;
+  for (const json& r : plan["runs"])
+    runs.push_back({r["name"].get<std::string>(), r["values"].get<std::vector<std::string>>(),
+                    r["overrides"].get<std::vector<std::string>>(), r.value("invalid", "")});
+  std::size_t complete = 0, failed = 0, missing = 0;
+  for (const PlannedRun& r : runs) {
+    const Variant v = inspectRun(dir, r);
+    (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
+  }
+  const std::string kind = plan.value("kind", "");
+  const std::string name = std::filesystem::path(o.scene).stem().string();
+  log << "collect " << kind << " of " << name << ": " << complete << " complete, " << failed << " failed, " << missing
+      << " missing of " << runs.size() << " runs\n";
+  if (kind == "sweep") return reportSweep(dir, o, plan["metrics"].get<std::vector<std::string>>(), runs, name, log);
+  if (kind == "study") return collectStudy(dir, o, plan, runs, log);
+  log << "error: collect: " << (dir / "plan.json").string() << ": unknown kind '" << kind << "'\n";
+  return kExitBadInput;
 }
 
 int runCalibrate(const CalibrateOptions& c, std::ostream& log) {

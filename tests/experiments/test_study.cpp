@@ -69,9 +69,11 @@ TEST_CASE("study analysis: errors against the finest - Pareto front - converged 
 TEST_CASE("study command: drop restitution against the time step", "[study][cli]") {
   const fs::path out = fs::temp_directory_path() / "rocklab-study-drop";
   fs::remove_all(out);
+  // In this process, one run after the other (the process pool is tested in test_run_plan.cpp).
   REQUIRE(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5,0.2,0.05", "--figure", "restitution",
-               "--tolerance", "1", "--out", out.string(), "--quiet"}) == 0);
-  for (const char* f : {"study.csv", "study.json", "study.png", "run-000/results.json", "run-002/results.json"})
+               "--tolerance", "1", "--jobs", "0", "--out", out.string(), "--quiet"}) == 0);
+  for (const char* f : {"study.csv", "study.json", "study.png", "plan.json", "runs.txt",
+                        "runs/timestep.safety_factor=0.5/results.json", "runs/timestep.safety_factor=0.05/results.json"})
     CHECK(fs::exists(out / f));
   std::ifstream in(out / "study.json");
   const nlohmann::json s = nlohmann::json::parse(in);
@@ -87,7 +89,7 @@ TEST_CASE("study command: drop restitution against the time step", "[study][cli]
 
   // A lab value as the reference.
   REQUIRE(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5,0.2", "--figure", "restitution",
-               "--reference", "0.7063", "--out", (out / "lab").string(), "--quiet"}) == 0);
+               "--reference", "0.7063", "--jobs", "0", "--out", (out / "lab").string(), "--quiet"}) == 0);
   std::ifstream in2(out / "lab" / "study.json");
   const nlohmann::json lab = nlohmann::json::parse(in2);
   CHECK(lab["reference"]["value"].get<double>() == 0.7063);
@@ -97,13 +99,26 @@ TEST_CASE("study command: drop restitution against the time step", "[study][cli]
 TEST_CASE("study: bad input is refused before any run", "[study][cli]") {
   const fs::path out = fs::temp_directory_path() / "rocklab-study-bad";
   fs::remove_all(out);
-  // A bad value of a varied key, no figure, a bad reference: exit 2, nothing run.
-  CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5,-1", "--figure", "restitution", "--out",
-             out.string(), "--quiet"}) == 2);
-  CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5", "--out", out.string(), "--quiet"}) == 2);
+  // No valid variant, no figure, a bad reference: exit 2, nothing written.
+  CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=-1,2", "--figure", "restitution", "--jobs", "0",
+             "--out", out.string(), "--quiet"}) == 2);
+  CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5", "--jobs", "0", "--out", out.string(), "--quiet"}) == 2);
   CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5", "--figure", "restitution", "--reference",
-             "fine", "--out", out.string(), "--quiet"}) == 2);
-  CHECK_FALSE(fs::exists(out / "run-000"));
+             "fine", "--jobs", "0", "--out", out.string(), "--quiet"}) == 2);
+  CHECK_FALSE(fs::exists(out));
+  // One bad value among good ones: it is listed as failed (exit 2, its message) and
+  // costs nothing; the others run; the command says some runs failed (exit 4).
+  CHECK(cli({"study", "drop", "--vary", "timestep.safety_factor=0.5,-1", "--figure", "restitution", "--jobs", "0",
+             "--out", out.string(), "--quiet"}) == 4);
+  std::ifstream csv(out / "study.csv");
+  std::string header, good, bad;
+  std::getline(csv, header);
+  std::getline(csv, good);
+  std::getline(csv, bad);
+  CHECK(good.find(",ok") != std::string::npos);
+  CHECK(bad.find("exit 2: --set timestep.safety_factor=-1") != std::string::npos);
+  CHECK_FALSE(fs::exists(out / "runs" / "timestep.safety_factor=-1"));
+  fs::remove_all(out);
   // A study file with an unknown key names the file and the key.
   const fs::path file = fs::temp_directory_path() / "rocklab-bad-study.toml";
   std::ofstream(file) << "[study]\nscene = \"drop\"\nfigure = \"restitution\"\ntolerence_pct = 1\n"

@@ -15,6 +15,7 @@ enum ExitCode : int {
   kExitOk = 0,
   kExitBadInput = 2,     // scene, option or file the user gave is unusable; nothing written
   kExitWatchdog = 3,     // the stability watchdog stopped the run; outputs so far kept
+  kExitRunsFailed = 4,   // a multi-run command finished, but some of its runs failed (see its table)
   kExitInterrupted = 130,  // Ctrl-C; outputs so far kept and readable
 };
 
@@ -30,5 +31,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log);
 
 /// Requests a clean stop of the running scene (called from the SIGINT handler).
 void requestStop();
+/// True after requestStop() until the next run starts.
+bool stopRequested();
 
 }  // namespace rocklab::experiments

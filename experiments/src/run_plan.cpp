@@ -1,0 +1,311 @@
+#include "run_plan.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <thread>
+
+#include "atomic_file.h"
+
+extern char** environ;
+
+namespace rocklab::experiments::detail {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Quoted for POSIX sh: 'it'\''s'.
+std::string shellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+/// key=value with characters a file name can carry; the rest become '_'.
+std::string folderName(const SweepOptions& o, const std::vector<std::string>& values) {
+  std::string name;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (k) name += "__";
+    for (char c : o.vary[k].first + "=" + values[k])
+      name += (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '=' || c == '-' || c == '+') ? c : '_';
+  }
+  if (name.size() > 120) {  // keep names short: a prefix and a hash of the whole
+    std::ostringstream h;
+    h << std::hex << std::hash<std::string>{}(name);
+    name = name.substr(0, 100) + "-" + h.str();
+  }
+  return name;
+}
+
+/// The rocklab executable the run lines call: ROCKLAB_EXE when set (tests that
+/// drive the CLI in-process set it), else this process's own executable.
+fs::path selfExecutable() {
+  if (const char* exe = std::getenv("ROCKLAB_EXE"); exe && *exe) return fs::absolute(exe);
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path("rocklab") : p;
+}
+
+bool complete(const fs::path& results) {
+  std::ifstream in(results);
+  if (!in) return false;
+  const json r = json::parse(in, nullptr, false);
+  return !r.is_discarded() && r.is_object() && r.value("status", "") == "completed";
+}
+
+/// The last line of a log that says what went wrong ("error: ..."), else its last line.
+std::string lastError(const fs::path& log_file) {
+  std::ifstream in(log_file);
+  std::string line, last, error;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    last = line;
+    if (line.rfind("error", 0) == 0 || line.find("rocklab: stopped") != std::string::npos) error = line;
+  }
+  return error.empty() ? last : error;
+}
+
+void writeExit(const fs::path& set_dir, const std::string& name, int code) {
+  writeAtomically(set_dir / "logs" / (name + ".exit"), std::to_string(code) + "\n");
+}
+
+std::string clock(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char text[32];
+  std::snprintf(text, sizeof text, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return text;
+}
+
+}  // namespace
+
+int defaultJobs() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+std::vector<PlannedRun> planRuns(const SweepOptions& o) {
+  std::vector<PlannedRun> runs;
+  std::map<std::string, int> seen;
+  for (const Variant& v : expandVariants(o)) {
+    PlannedRun r;
+    r.values = v.values;
+    r.name = folderName(o, v.values);
+    if (const int n = seen[r.name]++; n > 0) r.name += "-" + std::to_string(n + 1);
+    r.overrides = o.overrides;
+    bool seed_varied = false;
+    for (std::size_t k = 0; k < o.vary.size(); ++k) {
+      r.overrides.push_back(o.vary[k].first + "=" + v.values[k]);
+      seed_varied = seed_varied || o.vary[k].first == "scene.seed";
+    }
+    try {
+      const Scene scene = loadScene(resolveScene(o.scene), r.overrides);
+      // The seed in the line: each run is reproducible alone, whatever the file says later.
+      if (!seed_varied) r.overrides.push_back("scene.seed=" + std::to_string(scene.run.seed));
+    } catch (const SceneError& e) {
+      r.invalid = e.what();
+    }
+    runs.push_back(r);
+  }
+  return runs;
+}
+
+std::string runCommand(const fs::path& set_dir, const std::string& scene_path, const PlannedRun& run) {
+  const fs::path dir = fs::absolute(set_dir);
+  std::string line = shellQuote(selfExecutable().string()) + " run " + shellQuote(scene_path) + " --out " +
+                     shellQuote((dir / "runs" / run.name).string()) + " --threads 1 --quiet --skip-complete";
+  for (const std::string& s : run.overrides) line += " --set " + shellQuote(s);
+  const fs::path logs = dir / "logs";
+  line += " > " + shellQuote((logs / (run.name + ".log")).string()) + " 2>&1; echo $? > " +
+          shellQuote((logs / (run.name + ".exit")).string());
+  return line;
+}
+
+void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::vector<PlannedRun>& runs,
+                    const json& what) {
+  fs::create_directories(set_dir / "logs");
+  const fs::path dir = fs::absolute(set_dir);
+  const std::string scene_path = fs::absolute(resolveScene(o.scene)).string();
+  json vary = json::array();
+  for (const auto& [key, values] : o.vary) vary.push_back({{"key", key}, {"values", values}});
+  json list = json::array();
+  std::string lines;
+  for (const PlannedRun& r : runs) {
+    list.push_back({{"name", r.name}, {"values", r.values}, {"overrides", r.overrides}, {"invalid", r.invalid}});
+    lines += runCommand(dir, scene_path, r) + "\n";
+  }
+  json plan = what;
+  plan["scene"] = scene_path;
+  plan["overrides"] = o.overrides;
+  plan["vary"] = vary;
+  plan["runs"] = list;
+  writeAtomically(dir / "plan.json", plan.dump(2) + "\n");
+  writeAtomically(dir / "runs.txt", lines);
+
+  std::ostringstream sb;
+  sb << "#!/bin/bash\n"
+     << "# One Slurm array task per line of runs.txt (each run: one process, one thread).\n"
+     << "# Submit: sbatch " << (dir / "slurm.sbatch").string() << "; then: rocklab collect " << dir.string() << "\n"
+     << "#SBATCH --job-name=rocklab-" << fs::path(scene_path).stem().string() << "\n"
+     << "#SBATCH --array=1-" << runs.size() << "\n"
+     << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n"
+     << "#SBATCH --mem=" << o.slurm.memory << "\n"
+     << "#SBATCH --time=" << o.slurm.time << "\n";
+  if (!o.slurm.partition.empty()) sb << "#SBATCH --partition=" << o.slurm.partition << "\n";
+  sb << "#SBATCH --output=" << (dir / "logs" / "slurm-%A_%a.out").string() << "\n"
+     << "export OMP_NUM_THREADS=1\n"
+     << "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " << shellQuote((dir / "runs.txt").string()) << ")\n"
+     << "exec /bin/sh -c \"$line\"\n";
+  writeAtomically(dir / "slurm.sbatch", sb.str());
+
+  std::ostringstream rd;
+  rd << "# " << what.value("kind", std::string("set")) << " of " << fs::path(scene_path).stem().string() << ": "
+     << runs.size() << " independent runs\n\n"
+     << "Each line of `runs.txt` is one run: `rocklab run` with its own `--out` folder under `runs/`, every\n"
+     << "`--set` it needs (the seed included), one thread, its log and exit code under `logs/`. A line\n"
+     << "whose run already completed does nothing (`--skip-complete`), so running the list again, or\n"
+     << "after deleting one run folder, redoes only what is missing.\n\n"
+     << "Run the list on this machine with GNU parallel (one run per core):\n\n"
+     << "    parallel --jobs " << defaultJobs() << " < " << (dir / "runs.txt").string() << "\n\n"
+     << "or on a Slurm cluster as an array job (one task per line; resources in the header):\n\n"
+     << "    sbatch " << (dir / "slurm.sbatch").string() << "\n\n"
+     << "then merge the finished runs into the table, plot and recommendation:\n\n"
+     << "    rocklab collect " << dir.string() << "\n";
+  writeAtomically(dir / "README.md", rd.str());
+}
+
+Variant inspectRun(const fs::path& set_dir, const PlannedRun& run, std::string* error) {
+  Variant v;
+  v.values = run.values;
+  const fs::path results = set_dir / "runs" / run.name / "results.json";
+  if (complete(results)) {
+    std::ifstream in(results);
+    v.results = json::parse(in, nullptr, false);
+    v.code = kExitOk;
+    return v;
+  }
+  std::ifstream in(results);  // a stopped run's results (watchdog, Ctrl-C) still tell something
+  if (in) v.results = json::parse(in, nullptr, false);
+  if (v.results.is_discarded()) v.results = nullptr;
+  int code = kMissing;
+  if (std::ifstream ex{set_dir / "logs" / (run.name + ".exit")}; ex) ex >> code;
+  if (code == kExitOk) code = 1;  // exited 0 without a complete results.json: not a success
+  v.code = code;
+  if (error) *error = code == kMissing ? std::string() : lastError(set_dir / "logs" / (run.name + ".log"));
+  return v;
+}
+
+std::string failureStatus(int code, const std::string& error) {
+  if (code == kMissing) return "missing";
+  std::string s = "exit " + std::to_string(code);
+  if (!error.empty()) {
+    std::string e = error.rfind("error: ", 0) == 0 ? error.substr(7) : error;
+    e = e.substr(0, 160);
+    std::replace(e.begin(), e.end(), ',', ';');  // the table is CSV
+    s += ": " + e;
+  }
+  return s;
+}
+
+int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vector<PlannedRun>& runs, std::ostream& log) {
+  fs::create_directories(set_dir / "logs");
+  std::vector<const PlannedRun*> todo;
+  std::size_t skipped = 0;
+  for (const PlannedRun& r : runs) {
+    if (complete(set_dir / "runs" / r.name / "results.json")) {
+      ++skipped;
+    } else if (!r.invalid.empty()) {
+      writeAtomically(set_dir / "logs" / (r.name + ".log"), "error: " + r.invalid + "\n");
+      writeExit(set_dir, r.name, kExitBadInput);
+      log << "  " << r.name << ": invalid, not run: " << r.invalid << "\n";
+    } else {
+      todo.push_back(&r);
+    }
+  }
+  if (skipped) log << "  " << skipped << " of " << runs.size() << " runs already complete: not run again\n";
+  const int jobs = o.jobs < 0 ? defaultJobs() : o.jobs;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::size_t done = 0, failed = 0;
+  auto finished = [&](const PlannedRun& r, int code) {
+    ++done;
+    if (code != kExitOk) ++failed;
+    log << "  " << r.name << " -> " << (code == kExitOk ? "done" : "exit " + std::to_string(code)) << "\n";
+  };
+
+  if (jobs == 0) {  // in this process, one after the other, all threads each
+    for (const PlannedRun* r : todo) {
+      Scene scene = loadScene(resolveScene(o.scene), r->overrides);
+      RunOptions ro;
+      ro.out_dir = set_dir / "runs" / r->name;
+      ro.threads = o.threads;
+      ro.progress = o.progress;
+      int code;
+      {
+        std::ofstream run_log(set_dir / "logs" / (r->name + ".log"));
+        code = runScene(scene, ro, run_log);
+      }
+      writeExit(set_dir, r->name, code);
+      finished(*r, code);
+      if (code == kExitInterrupted) return kExitInterrupted;
+    }
+    return kExitOk;
+  }
+
+  // A pool of `jobs` processes, each one run of one thread: the lines of runs.txt.
+  const std::string scene_path = fs::absolute(resolveScene(o.scene)).string();
+  std::map<pid_t, const PlannedRun*> running;
+  std::size_t next = 0;
+  auto progress = [&] {
+    if (!o.progress) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::size_t left = todo.size() - done;
+    std::ostringstream line;
+    line << "runs: " << done << "/" << todo.size() << " done, " << failed << " failed, " << running.size()
+         << " running, " << jobs << " processes x 1 thread, elapsed " << clock(elapsed);
+    if (done > 0) line << ", ETA " << clock(elapsed / static_cast<double>(done) * static_cast<double>(left) /
+                                              std::max<std::size_t>(1, std::min<std::size_t>(jobs, left)) *
+                                              std::min<std::size_t>(jobs, todo.size()));
+    log << line.str() << "\n";
+  };
+  while (next < todo.size() || !running.empty()) {
+    while (!stopRequested() && next < todo.size() && static_cast<int>(running.size()) < jobs) {
+      const PlannedRun* r = todo[next++];
+      const std::string line = runCommand(set_dir, scene_path, *r);
+      const char* argv[] = {"/bin/sh", "-c", line.c_str(), nullptr};
+      pid_t pid = 0;
+      if (posix_spawn(&pid, "/bin/sh", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0) {
+        writeExit(set_dir, r->name, 1);
+        finished(*r, 1);
+        continue;
+      }
+      running[pid] = r;
+    }
+    if (running.empty()) break;
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;  // Ctrl-C: the children got it too; wait for them
+      break;
+    }
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const PlannedRun* r = it->second;
+    running.erase(it);
+    int code = 1;
+    if (std::ifstream ex{set_dir / "logs" / (r->name + ".exit")}; ex) ex >> code;
+    finished(*r, code);
+    progress();
+  }
+  return stopRequested() ? kExitInterrupted : kExitOk;
+}
+
+}  // namespace rocklab::experiments::detail

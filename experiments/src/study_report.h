@@ -1,0 +1,16 @@
+#pragma once
+// The study's report from a plan folder, for `rocklab collect`. Internal.
+#include <filesystem>
+#include <iosfwd>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "run_plan.h"
+
+namespace rocklab::experiments::detail {
+
+/// Table, plot and recommendation of a study set from plan.json and its runs.
+int collectStudy(const std::filesystem::path& dir, const SweepOptions& runs_options, const nlohmann::json& plan,
+                 const std::vector<PlannedRun>& runs, std::ostream& log);
+
+}  // namespace rocklab::experiments::detail

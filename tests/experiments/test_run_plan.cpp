@@ -1,0 +1,128 @@
+// Sweeps and studies as independent runs (issue 13): --plan + GNU parallel +
+// collect gives the same table as --jobs 2; a resumed set redoes only what is
+// missing; a failing variant is reported, not hidden.
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "rocklab/experiments/cli.h"
+
+namespace fs = std::filesystem;
+using rocklab::experiments::runCli;
+
+namespace {
+
+int cli(std::vector<std::string> args) {
+  // The run lines call the real rocklab executable, not this test binary.
+  ::setenv("ROCKLAB_EXE", (fs::path(ROCKLAB_BINARY_DIR) / "app" / "rocklab").c_str(), 1);
+  args.insert(args.begin(), "rocklab");
+  std::vector<const char*> argv;
+  for (auto& a : args) argv.push_back(a.c_str());
+  return runCli(static_cast<int>(argv.size()), argv.data());
+}
+
+fs::path fresh(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rocklab-plan-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+std::vector<std::string> lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+/// The first `columns` columns of a CSV (the deterministic ones: values and figures).
+std::vector<std::string> leading(const fs::path& csv, int columns) {
+  std::vector<std::string> out;
+  for (const std::string& l : lines(csv)) {
+    std::size_t pos = 0;
+    for (int c = 0; c < columns && pos != std::string::npos; ++c) pos = l.find(',', pos + (c ? 1 : 0));
+    out.push_back(l.substr(0, pos));
+  }
+  return out;
+}
+
+int shell(const std::string& command) { return std::system(command.c_str()); }
+
+const std::vector<std::string> kSweep = {"sweep", "drop", "--vary", "timestep.safety_factor=0.5,0.3,0.2",
+                                         "--metric", "restitution", "--metric", "drop.contact_time_s", "--quiet"};
+
+}  // namespace
+
+TEST_CASE("plan then GNU parallel then collect gives the table of --jobs 2", "[plan]") {
+  REQUIRE(shell("command -v parallel > /dev/null") == 0);  // Debian's `parallel`, installed by scripts/setup.sh
+  const fs::path planned = fresh("planned"), jobs = fresh("jobs");
+  auto with = [](std::vector<std::string> a, std::vector<std::string> more) {
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  REQUIRE(cli(with(kSweep, {"--plan", planned.string()})) == 0);
+  for (const char* f : {"plan.json", "runs.txt", "slurm.sbatch", "README.md"}) CHECK(fs::exists(planned / f));
+  CHECK_FALSE(fs::exists(planned / "runs"));  // nothing run
+  const auto run_lines = lines(planned / "runs.txt");
+  REQUIRE(run_lines.size() == 3);
+  CHECK(run_lines[0].find(" run ") != std::string::npos);
+  CHECK(run_lines[0].find("--set 'scene.seed=1'") != std::string::npos);  // each run reproducible alone
+  CHECK(run_lines[0].find("timestep.safety_factor=0.5") != std::string::npos);
+  const std::string sbatch = lines(planned / "slurm.sbatch").empty() ? "" : [&] {
+    std::ifstream in(planned / "slurm.sbatch");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }();
+  CHECK(sbatch.find("#SBATCH --array=1-3") != std::string::npos);
+
+  REQUIRE(shell("parallel --will-cite --jobs 2 < '" + (planned / "runs.txt").string() + "'") == 0);
+  REQUIRE(cli({"collect", planned.string()}) == 0);
+  REQUIRE(cli(with(kSweep, {"--jobs", "2", "--out", jobs.string()})) == 0);
+  // Values and figures are the same, digit for digit (runs are deterministic).
+  const auto a = leading(planned / "sweep.csv", 3), b = leading(jobs / "sweep.csv", 3);
+  REQUIRE(a.size() == 4);
+  CHECK(a == b);
+
+  // Running the same list again is safe: every line sees a complete run and does nothing.
+  const auto stamp = fs::last_write_time(planned / "runs" / "timestep.safety_factor=0.3" / "results.json");
+  REQUIRE(shell("parallel --will-cite --jobs 2 < '" + (planned / "runs.txt").string() + "'") == 0);
+  CHECK(fs::last_write_time(planned / "runs" / "timestep.safety_factor=0.3" / "results.json") == stamp);
+
+  // Resuming after one run folder was deleted redoes that run only.
+  fs::remove_all(jobs / "runs" / "timestep.safety_factor=0.2");
+  const auto kept = fs::last_write_time(jobs / "runs" / "timestep.safety_factor=0.5" / "results.json");
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(cli(with(kSweep, {"--jobs", "2", "--out", jobs.string()})) == 0);
+  CHECK(fs::exists(jobs / "runs" / "timestep.safety_factor=0.2" / "results.json"));
+  CHECK(fs::last_write_time(jobs / "runs" / "timestep.safety_factor=0.5" / "results.json") == kept);
+  CHECK(leading(jobs / "sweep.csv", 3) == b);
+  fs::remove_all(planned);
+  fs::remove_all(jobs);
+}
+
+TEST_CASE("collect reports failed and missing runs and never hides them", "[plan]") {
+  const fs::path dir = fresh("failing");
+  // A value the scene refuses (exit 2) and a forced step far above critical that
+  // the watchdog stops (exit 3), beside one good run.
+  const int code = cli({"study", "drop", "--vary", "timestep.dt=1e-6,2e-4,-1", "--set", "timestep.allow_unsafe=true",
+                        "--figure", "restitution", "--jobs", "2", "--out", dir.string(), "--quiet"});
+  CHECK(code == 4);  // finished, some runs failed
+  const auto table = lines(dir / "study.csv");
+  REQUIRE(table.size() == 4);
+  CHECK(table[1].find(",ok") != std::string::npos);
+  CHECK(table[2].find("exit 3") != std::string::npos);
+  CHECK(table[3].find("exit 2") != std::string::npos);
+  CHECK(table[3].find("timestep.dt") != std::string::npos);  // the error says which key
+  // A run that never ran is listed as missing.
+  fs::remove_all(dir / "runs" / "timestep.dt=1e-6");
+  fs::remove(dir / "logs" / "timestep.dt=1e-6.exit");
+  CHECK(cli({"collect", dir.string()}) == 4);
+  CHECK(lines(dir / "study.csv")[1].find("missing") != std::string::npos);
+  CHECK(cli({"collect", (dir / "nowhere").string()}) == 2);
+  fs::remove_all(dir);
+}
