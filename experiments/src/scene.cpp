@@ -214,6 +214,18 @@ BodyShape readClumpShape(TableReader& t, const std::string& shape, double densit
   BodyShape body;
   body.mass = props.mass;
   body.inertia = props.principal_moments;
+  // A clump made from a mesh (`rocklab shape`) may carry the mesh's own principal moments:
+  // the spheres set the contact surface, the solid they stand for sets the inertia. They
+  // apply along the union's principal axes, ascending (the clump file is written in the
+  // mesh's principal frame, so the two frames nearly agree).
+  if (t.has("principal_inertia")) {
+    if (!t.has("mass")) t.fail("principal_inertia", "give mass (kg) with principal_inertia (both are in rocklab shape's clump.toml)");
+    Vec3 moments = t.requiredVec3("principal_inertia");
+    std::sort(moments.data(), moments.data() + 3);
+    if (!(moments.x() > 0) || moments.z() > moments.x() + moments.y() * (1 + 1e-9))
+      t.fail("principal_inertia", "expected three positive moments (kg m^2) of a real body: the largest at most the sum of the other two");
+    body.inertia = moments;
+  }
   for (const auto& m : members)
     body.members.push_back({props.principal_axes.transpose() * (m.centre - props.centre_of_mass), m.radius});
   report.members = members.size();
@@ -223,7 +235,7 @@ BodyShape readClumpShape(TableReader& t, const std::string& shape, double densit
   report.union_volume_error = props.union_volume_error;
   report.equivalent_diameter = std::cbrt(6.0 * report.volume / std::numbers::pi);
   report.distribution = distribution;
-  report.principal_inertia = props.principal_moments;
+  report.principal_inertia = body.inertia;
   return body;
 }
 
