@@ -215,7 +215,7 @@ struct SweepRow {
   std::string method;
   geometry::ClumpFitError error;
   double generate_s = 0;
-  double ball_steps_per_s = NAN, clump_steps_per_s = NAN, pile_wall_s = NAN;
+  double ball_steps_per_s = NAN, clump_steps_per_s = NAN, pile_wall_s = NAN, pile_dt = NAN;
 };
 
 // A settling pile of `count` clumps in a box 7.5 d wide, dropped from up to 12 d:
@@ -261,6 +261,7 @@ void runPile(const ShapeOptions& o, const Prepared& p, const std::vector<Sphere>
   const json r = json::parse(in);
   row.ball_steps_per_s = r.at("particle_steps_per_s").get<double>();
   row.clump_steps_per_s = row.ball_steps_per_s / n;
+  row.pile_dt = r.at("dt_s").get<double>();  // the members' size sets the step: cost per simulated second
   log << "pile " << row.method << " " << n << " spheres: " << row.clump_steps_per_s << " clump-steps/s ("
       << row.pile_wall_s << " s)\n";
 }
@@ -347,12 +348,12 @@ int runShape(const ShapeOptions& o, std::ostream& log) {
     }
     std::ostringstream csv;
     csv << "method,spheres,volume_error,inertia_error,inertia_error_mass_scaled,surface_error_mean_m,surface_error_max_m,"
-           "generate_s,pile_ball_steps_per_s,pile_clump_steps_per_s,pile_wall_s\n";
+           "generate_s,pile_ball_steps_per_s,pile_clump_steps_per_s,pile_dt_s,pile_wall_s\n";
     for (const SweepRow& r : rows)
       csv << r.method << ',' << r.error.spheres << ',' << fmt(r.error.volume_error) << ',' << fmt(r.error.inertia_error)
           << ',' << fmt(r.error.inertia_error_mass_scaled) << ',' << fmt(r.error.surface_error_mean) << ','
           << fmt(r.error.surface_error_max) << ',' << fmt(r.generate_s) << ',' << fmt(r.ball_steps_per_s) << ','
-          << fmt(r.clump_steps_per_s) << ',' << fmt(r.pile_wall_s) << '\n';
+          << fmt(r.clump_steps_per_s) << ',' << fmt(r.pile_dt) << ',' << fmt(r.pile_wall_s) << '\n';
     detail::writeAtomically(o.out_dir / "shape_sweep.csv", csv.str());
     PlotSpec plot;
     plot.title = "Clump error against sphere count: " + std::filesystem::path(o.mesh).filename().string();
@@ -463,6 +464,7 @@ int runShape(const ShapeOptions& o, std::ostream& log) {
         j["pile_clump_steps_per_s"] = row.clump_steps_per_s;
         j["pile_ball_steps_per_s"] = row.ball_steps_per_s;
         j["pile_wall_s"] = row.pile_wall_s;
+        j["pile_dt_s"] = row.pile_dt;
       }
       r["sweep"].push_back(j);
     }

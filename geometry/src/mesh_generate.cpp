@@ -111,7 +111,7 @@ TriangleMesh generateParticle(ParticleKind kind, std::uint64_t seed, int level) 
       double a, w;
     };
     std::vector<Bump> bumps;
-    for (int k = 0; k < 12; ++k) bumps.push_back({randomUnit(rng), rng.uniform(-0.08, 0.08), rng.uniform(0.15, 0.5)});
+    for (int k = 0; k < 12; ++k) bumps.push_back({randomUnit(rng), rng.uniform(-0.12, 0.12), rng.uniform(0.15, 0.5)});
     for (int k = 0; k < 60; ++k) bumps.push_back({randomUnit(rng), rng.uniform(-0.012, 0.012), rng.uniform(0.01, 0.03)});
     const Vec3 axes(1.0, rng.uniform(0.75, 0.85), rng.uniform(0.55, 0.68));
     for (Vec3& u : m.vertices) {

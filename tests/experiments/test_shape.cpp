@@ -134,3 +134,34 @@ TEST_CASE("rocklab shape on the real scans in ../shared/meshes", "[shape][valida
     CHECK(r["checks"]["shells"] == 1);
   }
 }
+
+TEST_CASE("rocklab shape works on every mesh in assets/meshes", "[shape]") {
+  const fs::path assets = fs::path(ROCKLAB_SOURCE_DIR) / "assets" / "meshes";
+  const fs::path dir = tempDir("assets");
+  int meshes = 0;
+  for (const auto& e : fs::directory_iterator(assets)) {
+    const std::string ext = e.path().extension().string();
+    if (ext != ".stl" && ext != ".ply" && ext != ".obj") continue;
+    ++meshes;
+    INFO(e.path().string());
+    const fs::path out = dir / e.path().filename();
+    REQUIRE(cli({"shape", e.path().string(), "--unit", "mm", "--spheres", "8", "--no-preview", "--out", out.string()}) == 0);
+    const json r = readJson(out / "results.json");
+    CHECK(r["checks"]["warnings"].empty());  // generated meshes are clean
+    CHECK(r["mesh"]["equivalent_diameter_m"].get<double>() == Approx(0.02).epsilon(0.001));
+    CHECK(r["volume_error"].get<double>() <= 0.0);  // inscribed spheres
+    CHECK(r["volume_error"].get<double>() > -0.8);
+  }
+  CHECK(meshes >= 3);
+}
+
+TEST_CASE("the mesh-clump chute scene loads with the meshes' mass and inertia", "[shape]") {
+  const auto scene = rocklab::experiments::loadScene(fs::path(ROCKLAB_SOURCE_DIR) / "assets" / "scenes" /
+                                                     "chute-30-mesh-clumps.toml");
+  REQUIRE(scene.clumps.size() == 1680);
+  REQUIRE(scene.clump_shapes.size() == 3);
+  for (const auto& c : scene.clumps) {
+    CHECK(c.members.size() == 16);
+    CHECK(c.mass == Approx(0.0112647225));
+  }
+}

@@ -8,7 +8,7 @@
 // manifold, outward mesh without self-intersections, whatever ρ is (ρ > 0), so the
 // generators never make a bad mesh.
 //   pebble  — ellipsoid (axes 1 : 0.8 : 0.62) times a smooth bump field
-//             1 + Σ a_k exp((u·d_k − 1)/w_k) − mean, a few % roughness: a rounded
+//             1 + Σ a_k exp((u·d_k − 1)/w_k) (12 broad bumps of ±12 %, 60 fine ones of ±1.2 %): a rounded
 //             river pebble;
 //   crushed — the polytope of 10–14 random cutting planes (distance 0.75–1 from the
 //             centre, normals random): ρ(u) = min over planes of d_k / (n_k·u); faces
