@@ -245,3 +245,28 @@ TEST_CASE("every bad mesh class gives its message", "[mesh]") {
     CHECK(meshMassProperties(kept).volume == Approx(1e-6).epsilon(1e-6));
   }
 }
+
+TEST_CASE("a volume tolerance stops the greedy selection when it is met", "[mesh]") {
+  const TriangleMesh m = scaled(generateParticle(ParticleKind::Pebble, 5, 3), 0.01);
+  const MeshMassProperties p = meshMassProperties(m, 2700);
+  for (double tol : {0.3, 0.1}) {
+    MeshToClumpOptions o;
+    o.max_spheres = 500;
+    o.volume_tolerance = tol;
+    o.grid_cells = 32;
+    o.surface_samples = 2000;
+    o.max_candidates = 800;
+    const auto spheres = meshToClump(m, o);
+    INFO("tolerance " << tol << ": " << spheres.size() << " spheres");
+    CHECK(spheres.size() < 500);
+    // The grid's coverage is the stopping measure; the exact union may differ by the cells at the rim.
+    const double err = clumpFitError(p, spheres, {}, 128).volume_error;
+    CHECK(err < 0.0);
+    CHECK(-err < tol + 0.05);
+    // One sphere fewer would not have met it (the greedy stops at the first count that does).
+    if (spheres.size() > 1) {
+      const std::vector<Sphere> fewer(spheres.begin(), spheres.end() - 1);
+      CHECK(-clumpFitError(p, fewer, {}, 128).volume_error > tol - 0.05);
+    }
+  }
+}
