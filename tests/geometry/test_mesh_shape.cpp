@@ -148,6 +148,22 @@ TEST_CASE("mesh files in the three formats give the same mass properties", "[mes
     CHECK(report.warnings.empty());
     CHECK(relErr(meshMassProperties(back).volume, v) < 1e-5);  // float precision of the files
   }
+  // ASCII STL (written here by hand: facets with their own corner copies and normals).
+  {
+    std::ofstream stl(dir / "rock-ascii.stl");
+    stl << "solid rock\n";
+    for (const auto& t : m.triangles) {
+      stl << " facet normal 0 0 0\n  outer loop\n";
+      for (auto i : t) stl << "   vertex " << m.vertices[i].x() << ' ' << m.vertices[i].y() << ' ' << m.vertices[i].z() << '\n';
+      stl << "  endloop\n endfacet\n";
+    }
+    stl << "endsolid rock\n";
+  }
+  MeshCheckReport report;
+  const TriangleMesh ascii = checkAndRepairMesh(readMeshFile((dir / "rock-ascii.stl").string(), 1.0), "ascii", report);
+  CHECK(ascii.vertices.size() == m.vertices.size());
+  CHECK(report.warnings.empty());
+  CHECK(relErr(meshMassProperties(ascii).volume, v) < 1e-4);
   // Units: the same file read as millimetres is 1000x smaller.
   const TriangleMesh mm = readMeshFile((dir / "rock.stl").string(), 0.001);
   CHECK(relErr(meshMassProperties(mm).volume, 1e-9 * v) < 1e-5);
