@@ -266,9 +266,7 @@ void runPile(const ShapeOptions& o, const Prepared& p, const std::vector<Sphere>
       << row.pile_wall_s << " s)\n";
 }
 
-}  // namespace
-
-int runShape(const ShapeOptions& o, std::ostream& log) {
+int runShapeUnguarded(const ShapeOptions& o, std::ostream& log) {
   const auto t_start = Clock::now();
   Prepared p;
   try {
@@ -475,6 +473,17 @@ int runShape(const ShapeOptions& o, std::ostream& log) {
       << " %, surface error mean " << 1e3 * err.surface_error_mean << " mm, max " << 1e3 * err.surface_error_max
       << " mm; " << generate_s << " s → " << o.out_dir.string() << "\n";
   return kExitOk;
+}
+
+}  // namespace
+
+int runShape(const ShapeOptions& o, std::ostream& log) {
+  try {
+    return runShapeUnguarded(o, log);
+  } catch (const std::exception& e) {  // an output that cannot be written, a pile run that failed
+    log << "error: rocklab shape " << o.mesh << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
 }
 
 }  // namespace rocklab::experiments
