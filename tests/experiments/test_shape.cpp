@@ -10,7 +10,9 @@
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/shape.h"
 #include "rocklab/geometry/clump_shape.h"
+#include "rocklab/geometry/mesh_check.h"
 #include "rocklab/geometry/mesh_generate.h"
+#include "rocklab/geometry/mesh_properties.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -163,5 +165,47 @@ TEST_CASE("the mesh-clump chute scene loads with the meshes' mass and inertia", 
   for (const auto& c : scene.clumps) {
     CHECK(c.members.size() == 16);
     CHECK(c.mass == Approx(0.0112647225));
+  }
+}
+
+TEST_CASE("the clump frame is the mesh's principal frame and a scene keeps it", "[shape]") {
+  // clump.txt is written about the mesh's centroid and principal axes, with the transform
+  // back to the file; a scene with principal_inertia keeps the members in that frame (the
+  // union's own axes turn by up to tens of degrees for a flake, whose two larger moments
+  // are close, and would put the mesh's moments on the wrong axes).
+  const fs::path dir = tempDir("axes");
+  for (const char* kind : {"pebble", "crushed", "flake"}) {
+    INFO(kind);
+    const fs::path out = dir / kind, mesh_file = dir / (std::string(kind) + ".stl");
+    REQUIRE(cli({"shape", mesh_file.string(), "--generate", kind, "--unit", "mm", "--size", "0.02", "--spheres", "16",
+                 "--no-preview", "--out", out.string()}) == 0);
+    const json r = readJson(out / "results.json");
+    // The mesh taken into the clump frame by the stated transform: x = Rᵀ (s x_file − t).
+    const auto& tf = r["clump"]["to_file_frame"];
+    rocklab::geometry::Mat3 R;
+    rocklab::geometry::Vec3 t;
+    for (int i = 0; i < 3; ++i) {
+      t[i] = tf["t_m"][i].get<double>();
+      for (int j = 0; j < 3; ++j) R(i, j) = tf["R"][i][j].get<double>();
+    }
+    auto mesh = rocklab::geometry::readMeshFile(mesh_file.string(), 1.0);
+    for (auto& v : mesh.vertices) v = R.transpose() * (tf["s_m_per_file_unit"].get<double>() * v - t);
+    const auto props = rocklab::geometry::meshMassProperties(mesh, 2730);
+    CHECK(props.centroid.norm() < 1e-7);
+    for (int a = 0; a < 3; ++a) {
+      CHECK(props.inertia(a, a) == Approx(r["mesh"]["principal_moments_kg_m2"][a].get<double>()).epsilon(1e-5));
+      CHECK(std::abs(props.inertia(a, (a + 1) % 3)) < 1e-6 * props.inertia.norm());
+    }
+    // A scene with the clump.toml keys keeps the file's members and moments as they are.
+    std::ifstream keys(out / "clump.toml");
+    std::stringstream text;
+    text << "[scene]\nname = \"t\"\nend_time = 0.001\n[materials.rock]\ndensity = 2730\nkn = 1e7\nks = 1e7\n"
+            "friction = 0.3\n[[particles]]\ntype = \"list\"\nmaterial = \"rock\"\npositions = [[0.0, 0.0, 0.1]]\n"
+         << keys.rdbuf();
+    const auto scene = rocklab::experiments::loadSceneText(text.str(), "t.toml", {}, out);
+    const auto members = rocklab::geometry::readClumpFile((out / "clump.txt").string());
+    REQUIRE(scene.clumps.at(0).members.size() == members.size());
+    for (std::size_t k = 0; k < members.size(); ++k)
+      CHECK((scene.clumps[0].members[k].centre - members[k].centre).norm() < 1e-12);
   }
 }
