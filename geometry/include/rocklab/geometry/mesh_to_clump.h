@@ -11,7 +11,10 @@
 //    the sphere centred at v + r n keeps p outside (allowing it to sit `touch_tolerance`
 //    t inside, so scan noise does not pin the radius) while
 //        |d|² − 2 r d·n + r² ≥ (r − t)²   ⇔   r ≤ (|d|² − t²) / (2 (d·n − t))   for d·n > t,
-//    and r is the minimum of that bound over all nodes.
+//    and r is the minimum of that bound over all nodes. The tolerance fixes the centre
+//    c = v + r n; the candidate's radius is then what fits there (the distance from c to
+//    the nearest node), and a chosen sphere is refined on the exact distance to the mesh
+//    (centre moved up its gradient by at most max(t, 0.001 d_eq)), so it stays inscribed.
 //  MedialAxis — centres of maximal inscribed balls on a voxel grid: the local maxima
 //    of the distance transform (mesh_voxels.h), radius = distance to the surface.
 //    A chosen ball's centre is then moved up the gradient of the exact distance to
@@ -40,7 +43,8 @@ struct MeshToClumpOptions {
   ClumpMethod method = ClumpMethod::SurfaceSpheres;
   int max_spheres = 20;           // upper limit on the count
   double volume_tolerance = 0.0;  // stop when the uncovered inside fraction is <= this (0 = use max_spheres)
-  // Lengths as fractions of the mesh's equivalent diameter d_eq (so one setting suits any size).
+  // Lengths as fractions of the mesh's equivalent diameter d_eq (so one setting suits any size;
+  // d_eq is taken from the inside grid's volume, ± a cell).
   double min_radius = 0.0;        // candidates with radius < min_radius d_eq are discarded (sets the DEM time step)
   // SurfaceSpheres: how deep a node may lie inside a sphere (t = touch_tolerance d_eq). Without it a
   // vertex normal a fraction of a degree off (an icosphere's are) lets the next vertex pin the radius.
