@@ -62,9 +62,19 @@ std::vector<Sphere> surfaceCandidates(const TriangleMesh& mesh, const MeshToClum
 
 // Moves a ball centre up the gradient of the distance to the surface (away from its
 // closest point) by at most `reach`, and gives it that exact distance as radius.
+// Within `reach` of the start the distance is at most r0 + reach, so only triangles
+// whose bounding box comes within r0 + 2 reach of the start can be closest: the
+// iterations search those (tens of triangles of an 80k-triangle scan, not all).
 Sphere refineBall(const TriangleMesh& mesh, Vec3 c, double reach) {
   Vec3 q = mesh.closestPoint(c);
   double r = (c - q).norm();
+  TriangleMesh near;
+  near.vertices = mesh.vertices;
+  for (const auto& t : mesh.triangles) {
+    AABB box;
+    for (auto i : t) box.extend(mesh.vertices[i]);
+    if (box.distance(c) <= r + 2 * reach) near.triangles.push_back(t);
+  }
   const Vec3 start = c;
   double step = 0.25 * reach;
   for (int it = 0; it < 40 && step > 1e-4 * reach; ++it) {
@@ -74,7 +84,7 @@ Sphere refineBall(const TriangleMesh& mesh, Vec3 c, double reach) {
       step *= 0.5;
       continue;
     }
-    const Vec3 tq = mesh.closestPoint(trial);
+    const Vec3 tq = near.closestPoint(trial);
     const double tr = (trial - tq).norm();
     if (tr > r) {
       c = trial;
