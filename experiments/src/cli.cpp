@@ -9,6 +9,7 @@
 #include "rocklab/experiments/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
+#include "rocklab/experiments/shape.h"
 #include "rocklab/experiments/study.h"
 #include "rocklab/experiments/sweep.h"
 #include "rocklab/sim/output/checkpoint.h"
@@ -159,6 +160,29 @@ int runCli(int argc, const char* const* argv) {
                                                 "plot and recommendation (failed and missing runs listed)");
   collect->add_option("dir", collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
 
+  ShapeOptions shape_options;
+  bool no_preview = false;
+  auto* shape = app.add_subcommand("shape", "Mesh (STL/PLY/OBJ) -> checked mass properties and a clump of spheres with its error");
+  shape->add_option("mesh", shape_options.mesh, "Mesh file (with --generate: the mesh file to write, .stl/.ply/.obj)")->required();
+  shape->add_option("--out", shape_options.out_dir, "Output directory (clump.txt, clump.toml, preview.png, results.json)")->required();
+  shape->add_option("--method", shape_options.method, "surface (tangent spheres grown from the surface) | medial (medial axis)");
+  shape->add_option("--spheres", shape_options.spheres, "Largest number of spheres");
+  shape->add_option("--tolerance", shape_options.tolerance, "Stop when the uncovered volume fraction is below this (0 = off)");
+  shape->add_option("--unit", shape_options.unit, "Unit of the file's coordinates: m | mm");
+  shape->add_option("--size", shape_options.size, "Scale to this size (m); see --size-kind");
+  shape->add_option("--size-kind", shape_options.size_kind, "equivalent (equal-volume sphere diameter) | sieve");
+  shape->add_option("--density", shape_options.density, "kg/m^3 (mass and inertia in clump.toml)");
+  shape->add_option("--min-radius", shape_options.min_radius, "Smallest member radius, fraction of the equivalent diameter");
+  shape->add_option("--touch", shape_options.touch, "Surface method: node tolerance, fraction of the equivalent diameter");
+  shape->add_option("--grid", shape_options.grid, "Inside-grid cells along the longest extent");
+  shape->add_option("--generate", shape_options.generate, "Make a seeded scan-like mesh first: pebble | crushed | flake");
+  shape->add_option("--seed", shape_options.seed, "Seed of --generate and of the surface samples");
+  shape->add_option("--sweep", shape_options.sweep, "Sphere counts for the error table, e.g. 1,2,4,8,16")->delimiter(',');
+  shape->add_flag("--pile", shape_options.pile, "With --sweep: time a settling pile of clumps for each count");
+  shape->add_option("--pile-clumps", shape_options.pile_clumps, "Clumps in the pile");
+  shape->add_option("--pile-time", shape_options.pile_time, "Simulated time of the pile (s)");
+  shape->add_flag("--no-preview", no_preview, "Do not render preview.png");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -174,6 +198,10 @@ int runCli(int argc, const char* const* argv) {
 
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("collect")) return collectSet(collect_dir, std::cerr);
+  if (app.got_subcommand("shape")) {
+    shape_options.preview = !no_preview;
+    return runShape(shape_options, std::cerr);
+  }
   if (app.got_subcommand("render")) return renderRun({checkpoint_arg, camera_file, out_dir}, std::cerr);
   if (app.got_subcommand("study")) {
     std::signal(SIGINT, onSigint);

@@ -214,8 +214,25 @@ BodyShape readClumpShape(TableReader& t, const std::string& shape, double densit
   BodyShape body;
   body.mass = props.mass;
   body.inertia = props.principal_moments;
-  for (const auto& m : members)
-    body.members.push_back({props.principal_axes.transpose() * (m.centre - props.centre_of_mass), m.radius});
+  // A clump made from a mesh (`rocklab shape`) carries the mesh's own mass properties:
+  // the spheres set the contact surface, the solid they stand for sets the inertia. Its
+  // file is written in the mesh's principal frame, so with principal_inertia the file's
+  // origin is the centre of mass and its x, y, z axes are the principal axes of these
+  // moments: the members are kept as they are (the union's own axes would differ, e.g.
+  // by 26 deg in the plane of a flake whose two larger moments are close).
+  if (t.has("principal_inertia")) {
+    if (!t.has("mass")) t.fail("principal_inertia", "give mass (kg) with principal_inertia (both are in rocklab shape's clump.toml)");
+    const Vec3 moments = t.requiredVec3("principal_inertia");
+    for (int a = 0; a < 3; ++a)
+      if (!(moments[a] > 0) || moments[a] > (moments.sum() - moments[a]) * (1 + 1e-9))
+        t.fail("principal_inertia", "expected three positive moments (kg m^2) about the clump file's x, y, z axes, "
+                                    "each at most the sum of the other two");
+    body.inertia = moments;
+    body.members = members;
+  } else {
+    for (const auto& m : members)
+      body.members.push_back({props.principal_axes.transpose() * (m.centre - props.centre_of_mass), m.radius});
+  }
   report.members = members.size();
   report.mass = props.mass;
   report.volume = props.mass / density;
@@ -223,7 +240,7 @@ BodyShape readClumpShape(TableReader& t, const std::string& shape, double densit
   report.union_volume_error = props.union_volume_error;
   report.equivalent_diameter = std::cbrt(6.0 * report.volume / std::numbers::pi);
   report.distribution = distribution;
-  report.principal_inertia = props.principal_moments;
+  report.principal_inertia = body.inertia;
   return body;
 }
 

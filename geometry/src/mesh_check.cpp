@@ -1,0 +1,243 @@
+#include "rocklab/geometry/mesh_check.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+namespace rocklab::geometry {
+
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+
+// One use of an undirected edge by a triangle; `forward` when the triangle runs
+// lo → hi along it.
+struct EdgeUse {
+  std::uint64_t key;
+  std::uint32_t triangle;
+  bool forward;
+};
+
+std::vector<EdgeUse> edgeUses(const std::vector<Tri>& tris) {
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * tris.size());
+  for (std::uint32_t t = 0; t < tris.size(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = tris[t][e], b = tris[t][(e + 1) % 3];
+      const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+      uses.push_back({(std::uint64_t{lo} << 32) | hi, t, a == lo});
+    }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
+  });
+  return uses;
+}
+
+double signedVolume(const std::vector<Vec3>& v, const std::vector<Tri>& tris, const std::vector<std::uint32_t>& which) {
+  // Divergence theorem: sum of signed tetrahedra (origin, a, b, c).
+  double six_v = 0;
+  for (std::uint32_t t : which) six_v += v[tris[t][0]].dot(v[tris[t][1]].cross(v[tris[t][2]]));
+  return six_v / 6.0;
+}
+
+}  // namespace
+
+TriangleMesh weldIdenticalVertices(const TriangleMesh& mesh) {
+  std::map<std::array<double, 3>, std::uint32_t> index;
+  std::vector<std::uint32_t> remap(mesh.vertices.size());
+  TriangleMesh out;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3& p = mesh.vertices[i];
+    const auto [it, inserted] = index.try_emplace({p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(out.vertices.size()));
+    if (inserted) out.vertices.push_back(p);
+    remap[i] = it->second;
+  }
+  out.triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) out.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+  return out;
+}
+
+TriangleMesh readMeshFile(const std::string& path, double scale) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw MeshCheckError("mesh file '" + path + "' does not exist");
+  if (!std::ifstream(path).good()) throw MeshCheckError("mesh file '" + path + "' cannot be opened for reading");
+  Assimp::Importer importer;
+  // No JoinIdenticalVertices here: welding is done below across all meshes of the file.
+  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  if (!scene || !scene->mRootNode)
+    throw MeshCheckError("mesh file '" + path + "' cannot be read (STL ascii/binary, PLY and OBJ are supported): " +
+                         importer.GetErrorString());
+  TriangleMesh soup;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D& p = am->mVertices[v];
+      soup.vertices.emplace_back(scale * p.x, scale * p.y, scale * p.z);
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      soup.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+  }
+  if (soup.triangles.empty()) throw MeshCheckError("mesh file '" + path + "' contains no triangles");
+  return weldIdenticalVertices(soup);
+}
+
+TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& name, MeshCheckReport& report) {
+  const std::string where = "mesh '" + name + "': ";
+  report = MeshCheckReport{};
+  report.input_triangles = mesh.triangles.size();
+  report.vertices = mesh.vertices.size();
+  if (mesh.triangles.empty()) throw MeshCheckError(where + "contains no triangles");
+  for (const Tri& t : mesh.triangles)
+    for (std::uint32_t i : t)
+      if (i >= mesh.vertices.size()) throw MeshCheckError(where + "a triangle refers to a vertex that does not exist");
+
+  // 1. Degenerate triangles: collapsed ones (a repeated vertex) have no three edges
+  //    and are removed; zero-area ones with three distinct vertices are kept.
+  std::vector<Tri> tris;
+  for (const Tri& t : mesh.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+      ++report.collapsed_removed;
+      continue;
+    }
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    if (!((b - a).cross(c - a).squaredNorm() > 0)) ++report.zero_area;
+    tris.push_back(t);
+  }
+  if (tris.empty()) throw MeshCheckError(where + "every triangle is degenerate (repeated vertices): no surface");
+  if (report.collapsed_removed)
+    report.warnings.push_back(std::to_string(report.collapsed_removed) +
+                              " degenerate triangles (two corners at the same point) removed");
+  if (report.zero_area)
+    report.warnings.push_back(std::to_string(report.zero_area) +
+                              " degenerate triangles of zero area (collinear corners) kept; they add no volume");
+
+  // 2. Edge topology: closed = every edge used exactly twice.
+  const std::vector<EdgeUse> uses = edgeUses(tris);
+  std::vector<std::vector<std::pair<std::uint32_t, bool>>> neighbours(tris.size());  // (triangle, same direction)
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    const std::size_t n = j - i;
+    if (n == 1) ++report.boundary_edges;
+    if (n > 2) ++report.nonmanifold_edges;
+    if (n == 2) {
+      const EdgeUse &x = uses[i], &y = uses[i + 1];
+      const bool same = x.forward == y.forward;  // same direction = orientations disagree
+      neighbours[x.triangle].push_back({y.triangle, same});
+      neighbours[y.triangle].push_back({x.triangle, same});
+    }
+    i = j;
+  }
+  if (report.boundary_edges || report.nonmanifold_edges) {
+    std::ostringstream msg;
+    msg << where;
+    if (report.boundary_edges)
+      msg << "not closed: " << report.boundary_edges
+          << " open boundary edges (edges of only one triangle: holes or cracks)";
+    if (report.boundary_edges && report.nonmanifold_edges) msg << "; ";
+    if (report.nonmanifold_edges)
+      msg << report.nonmanifold_edges << " non-manifold edges (shared by more than two triangles)";
+    msg << ". A clump needs one closed, manifold surface: repair the scan (e.g. close holes, "
+           "remove duplicate faces) and try again";
+    throw MeshCheckError(msg.str());
+  }
+
+  // 3. Shells and orientation: breadth-first over shared edges; a neighbour whose
+  //    shared edge runs the same way must be flipped relative to its parent.
+  std::vector<int> shell(tris.size(), -1);
+  std::vector<char> flip(tris.size(), 0);
+  std::vector<std::vector<std::uint32_t>> members;
+  for (std::uint32_t seed = 0; seed < tris.size(); ++seed) {
+    if (shell[seed] >= 0) continue;
+    const int s = static_cast<int>(members.size());
+    members.emplace_back();
+    std::vector<std::uint32_t> queue{seed};
+    shell[seed] = s;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const std::uint32_t t = queue[q];
+      members[s].push_back(t);
+      for (const auto& [u, same] : neighbours[t]) {
+        const char want = static_cast<char>(flip[t] ^ (same ? 1 : 0));
+        if (shell[u] < 0) {
+          shell[u] = s;
+          flip[u] = want;
+          queue.push_back(u);
+        } else if (flip[u] != want) {
+          throw MeshCheckError(where + "a shell cannot be oriented consistently (a Moebius-like or "
+                                       "self-touching surface); repair the scan");
+        }
+      }
+    }
+    // Majority rule: the fewer triangles are the wrongly oriented ones.
+    std::size_t flipped = 0;
+    for (std::uint32_t t : members[s]) flipped += flip[t];
+    if (2 * flipped > members[s].size()) {
+      for (std::uint32_t t : members[s]) flip[t] ^= 1;
+      flipped = members[s].size() - flipped;
+    }
+    report.flipped_inconsistent += flipped;
+  }
+  for (std::uint32_t t = 0; t < tris.size(); ++t)
+    if (flip[t]) std::swap(tris[t][1], tris[t][2]);
+  if (report.flipped_inconsistent)
+    report.warnings.push_back(std::to_string(report.flipped_inconsistent) +
+                              " triangles were oriented against their neighbours and were flipped");
+
+  // 4. Keep the largest shell (by |volume|); flip it if it is inside out.
+  report.shells = members.size();
+  std::size_t best = 0;
+  double best_volume = 0;
+  std::vector<double> volumes;
+  for (std::size_t s = 0; s < members.size(); ++s) {
+    volumes.push_back(signedVolume(mesh.vertices, tris, members[s]));
+    if (std::abs(volumes[s]) > std::abs(best_volume)) {
+      best_volume = volumes[s];
+      best = s;
+    }
+  }
+  if (!(std::abs(best_volume) > 0)) throw MeshCheckError(where + "encloses no volume (flat surface)");
+  if (members.size() > 1) {
+    report.dropped_triangles = tris.size() - members[best].size();
+    std::ostringstream msg;
+    msg << members.size() << " disconnected shells; kept the largest (" << members[best].size()
+        << " triangles, " << std::abs(best_volume) << " m^3) and dropped " << members.size() - 1 << " ("
+        << report.dropped_triangles << " triangles)";
+    report.warnings.push_back(msg.str());
+  }
+  report.flipped_inward = best_volume < 0;
+  if (report.flipped_inward) report.warnings.push_back("normals pointed inward (negative volume); all triangles flipped");
+
+  // Compact: only the kept shell's vertices, numbered in order of first use.
+  std::vector<std::uint32_t> kept = members[best];
+  std::sort(kept.begin(), kept.end());
+  std::vector<std::uint32_t> remap(mesh.vertices.size(), UINT32_MAX);
+  TriangleMesh out;
+  for (std::uint32_t t : kept) {
+    Tri tri = tris[t];
+    if (report.flipped_inward) std::swap(tri[1], tri[2]);
+    for (std::uint32_t& i : tri) {
+      if (remap[i] == UINT32_MAX) {
+        remap[i] = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[i]);
+      }
+      i = remap[i];
+    }
+    out.triangles.push_back(tri);
+  }
+  return out;
+}
+
+}  // namespace rocklab::geometry
