@@ -126,3 +126,24 @@ TEST_CASE("collect reports failed and missing runs and never hides them", "[plan
   CHECK(cli({"collect", (dir / "nowhere").string()}) == 2);
   fs::remove_all(dir);
 }
+
+TEST_CASE("the Slurm array script on a local one-node Slurm gives the table of --jobs 2", "[plan][validation]") {
+  // Starts (installing if needed) slurmctld + slurmd + munge on this machine.
+  REQUIRE(shell("bash '" ROCKLAB_SOURCE_DIR "/scripts/local-slurm.sh' > /dev/null") == 0);
+  const fs::path planned = fresh("slurm"), jobs = fresh("slurm-jobs");
+  std::vector<std::string> plan = kSweep, local = kSweep;
+  plan.insert(plan.end(), {"--plan", planned.string(), "--slurm-time", "00:10:00", "--slurm-mem", "1G"});
+  local.insert(local.end(), {"--jobs", "2", "--out", jobs.string()});
+  REQUIRE(cli(plan) == 0);
+  REQUIRE(shell("sbatch --wait '" + (planned / "slurm.sbatch").string() + "' > /dev/null") == 0);
+  REQUIRE(cli({"collect", planned.string()}) == 0);
+  REQUIRE(cli(local) == 0);
+  const auto a = leading(planned / "sweep.csv", 3);
+  REQUIRE(a.size() == 4);
+  CHECK(a == leading(jobs / "sweep.csv", 3));
+  int slurm_logs = 0;  // one per array task
+  for (const auto& e : fs::directory_iterator(planned / "logs")) slurm_logs += e.path().filename().string().rfind("slurm-", 0) == 0;
+  CHECK(slurm_logs == 3);
+  fs::remove_all(planned);
+  fs::remove_all(jobs);
+}

@@ -226,3 +226,10 @@ TEST_CASE("camera keys are checked and a scene without cameras has none", "[scen
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.motion_blur=true"}), Contains("needs exposure > 0 s"));
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.lens=1"}), Contains("cameras.0.lens"));
 }
+
+TEST_CASE("contact.stiffness_scale scales every material's stiffness - and spaces around = in --set", "[scene]") {
+  const Scene s = loadSceneText(kMinimal, "min.toml", {"contact.stiffness_scale = 0.01"});
+  CHECK(s.model.materials[0].kn == Approx(1e5));
+  CHECK(s.model.materials[0].ks == Approx(1e5));
+  CHECK_THAT(errorOf(kMinimal, {"contact.stiffness_scale=0"}), Contains("stiffness_scale") && Contains("> 0"));
+}
