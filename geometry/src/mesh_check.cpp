@@ -12,6 +12,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "assimp_mesh.h"
+
 namespace rocklab::geometry {
 
 namespace {
@@ -76,20 +78,7 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
   if (!scene || !scene->mRootNode)
     throw MeshCheckError("mesh file '" + path + "' cannot be read (STL ascii/binary, PLY and OBJ are supported): " +
                          importer.GetErrorString());
-  TriangleMesh soup;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* am = scene->mMeshes[m];
-    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-    for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiVector3D& p = am->mVertices[v];
-      soup.vertices.emplace_back(scale * p.x, scale * p.y, scale * p.z);
-    }
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      soup.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
-    }
-  }
+  TriangleMesh soup = detail::trianglesOf(*scene, scale);
   if (soup.triangles.empty()) throw MeshCheckError("mesh file '" + path + "' contains no triangles");
   return weldIdenticalVertices(soup);
 }

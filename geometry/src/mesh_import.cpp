@@ -4,6 +4,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "assimp_mesh.h"
+
 namespace rocklab::geometry {
 
 TriangleMesh importMesh(const std::string& path, double scale) {
@@ -15,21 +17,7 @@ TriangleMesh importMesh(const std::string& path, double scale) {
                 aiProcess_PreTransformVertices);
   if (!scene || !scene->mRootNode)
     throw MeshImportError("cannot read mesh '" + path + "': " + importer.GetErrorString());
-  TriangleMesh mesh;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* am = scene->mMeshes[m];
-    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
-    for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiVector3D& p = am->mVertices[v];
-      mesh.vertices.emplace_back(scale * p.x, scale * p.y, scale * p.z);
-    }
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      mesh.triangles.push_back(
-          {base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
-    }
-  }
+  TriangleMesh mesh = detail::trianglesOf(*scene, scale);
   if (mesh.triangles.empty())
     throw MeshImportError("mesh '" + path + "' contains no triangles");
   return mesh;

@@ -9,18 +9,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "rocklab/experiments/cli.h"
+#include "cli_support.h"
 
 namespace fs = std::filesystem;
-using rocklab::experiments::runCli;
 
 namespace {
-int cli(std::vector<std::string> args) {
-  args.insert(args.begin(), "rocklab");
-  std::vector<const char*> argv;
-  for (auto& a : args) argv.push_back(a.c_str());
-  return runCli(static_cast<int>(argv.size()), argv.data());
-}
+using rocklab::experiments::test::cli;
 fs::path tempDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name);
   fs::remove_all(d);

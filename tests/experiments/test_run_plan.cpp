@@ -10,20 +10,16 @@
 #include <sstream>
 #include <thread>
 
-#include "rocklab/experiments/cli.h"
+#include "cli_support.h"
 
 namespace fs = std::filesystem;
-using rocklab::experiments::runCli;
 
 namespace {
 
 int cli(std::vector<std::string> args) {
   // The run lines call the real rocklab executable, not this test binary.
   ::setenv("ROCKLAB_EXE", (fs::path(ROCKLAB_BINARY_DIR) / "app" / "rocklab").c_str(), 1);
-  args.insert(args.begin(), "rocklab");
-  std::vector<const char*> argv;
-  for (auto& a : args) argv.push_back(a.c_str());
-  return runCli(static_cast<int>(argv.size()), argv.data());
+  return rocklab::experiments::test::cli(std::move(args));
 }
 
 fs::path fresh(const std::string& name) {

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "rocklab/experiments/cli.h"
+#include "cli_support.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/shape.h"
 #include "rocklab/geometry/clump_shape.h"
@@ -16,15 +16,9 @@
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using rocklab::experiments::runCli;
 
 namespace {
-int cli(std::vector<std::string> args) {
-  args.insert(args.begin(), "rocklab");
-  std::vector<const char*> argv;
-  for (auto& a : args) argv.push_back(a.c_str());
-  return runCli(static_cast<int>(argv.size()), argv.data());
-}
+using rocklab::experiments::test::cli;
 fs::path tempDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("rocklab-shape-" + name);
   fs::remove_all(d);

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "rocklab/experiments/cli.h"
+#include "cli_support.h"
 #include "rocklab/experiments/study.h"
 
 namespace fs = std::filesystem;
@@ -23,12 +23,7 @@ StudyPoint point(double figure, double wall, bool ok = true) {
   return p;
 }
 
-int cli(std::vector<std::string> args) {
-  args.insert(args.begin(), "rocklab");
-  std::vector<const char*> argv;
-  for (auto& a : args) argv.push_back(a.c_str());
-  return runCli(static_cast<int>(argv.size()), argv.data());
-}
+using rocklab::experiments::test::cli;
 
 }  // namespace
 

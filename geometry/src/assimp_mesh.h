@@ -1,0 +1,31 @@
+#pragma once
+// The triangles of every mesh of an assimp scene as one TriangleMesh (vertices
+// scaled; faces that are not triangles — points, lines — skipped). Shared by
+// importMesh (mesh walls) and readMeshFile (particle scans). Internal.
+#include <cstdint>
+
+#include <assimp/scene.h>
+
+#include "rocklab/geometry/triangle_mesh.h"
+
+namespace rocklab::geometry::detail {
+
+inline TriangleMesh trianglesOf(const aiScene& scene, double scale) {
+  TriangleMesh mesh;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* am = scene.mMeshes[m];
+    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D& p = am->mVertices[v];
+      mesh.vertices.emplace_back(scale * p.x, scale * p.y, scale * p.z);
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines carry no surface
+      mesh.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+  }
+  return mesh;
+}
+
+}  // namespace rocklab::geometry::detail
