@@ -1,6 +1,8 @@
 #include "marker_tracking.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace rocklab::experiments {
 
@@ -12,8 +14,21 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   // Projected disc of the marker at the plane's depth along the optical axis.
   const geometry::Vec3 centre_on_plane(camera_.position().x(), plane_y, camera_.position().z());
   const double depth = std::abs(camera_.toCamera(centre_on_plane).z());
-  const double r_px = 0.5 * (camera_.fx + camera_.fy) * radius / std::max(depth, 1e-9);
+  const double px_per_m = 0.5 * (camera_.fx + camera_.fy) / std::max(depth, 1e-9);
+  const double r_px = px_per_m * radius;
   detector_.expected_area_px = 3.14159265358979 * r_px * r_px;
+  // Gate: what a marker can move between two frames beyond the constant-velocity
+  // prediction (up to kMaxSpeed for one frame) plus centroid jitter (up to a radius:
+  // the visible part of a clump changes as it turns), so a track does not jump to a
+  // touching neighbour one diameter away.
+  // A marker hidden for a moment (it turns its paint away, a neighbour covers it) is
+  // re-found for up to kMaxHidden.
+  constexpr double kMaxSpeed = 1.0;    // m/s: faster than any marker of the chute
+  constexpr double kMaxHidden = 0.05;  // s
+  track::LinkSettings link;
+  link.max_distance_px = r_px + px_per_m * kMaxSpeed / camera_.frameRate;
+  link.max_missed_frames = std::max(3, static_cast<int>(std::lround(kMaxHidden * camera_.frameRate)));
+  linker_ = track::Linker(link);
 }
 
 void MarkerTracking::addFrame(std::uint64_t frame, double time, const cv::Mat& bgr) {
