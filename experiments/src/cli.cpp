@@ -22,11 +22,11 @@ namespace {
 constexpr const char* kExamples = R"(
 Examples:
   rocklab demo                                   # default scene end to end, outputs in out/demo
-  rocklab list                                   # built-in scenes
-  rocklab run pour --out runs/pour               # a built-in scene by name
+  rocklab list                                   # built-in scenes and studies
+  rocklab run hopper --out runs/hopper           # a built-in scene by name
   rocklab run my.toml --set timestep.safety_factor=0.3 --set output.vtk=true
   rocklab check my.toml                          # validate and print the time-step audit only
-  rocklab restart runs/pour/checkpoint.h5 --set scene.end_time=2.0 --out runs/pour2
+  rocklab restart runs/hopper/checkpoint.h5 --set scene.end_time=2.0 --out runs/hopper2
   rocklab run drop                               # restitution of one pebble drop (results.json)
   rocklab calibrate drop --vary contact.damping_normal=0:0.4 --target restitution=0.72
   rocklab calibrate heap --vary materials.pebble.friction=0.2,0.3,0.4,0.5 --target angle_of_repose_deg=26.03
@@ -68,6 +68,21 @@ int doList() {
     std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ')
               << firstLine(description) << "\n";
   }
+  std::cout << "built-in studies (" << builtinStudyDir().string() << "; rocklab study NAME):\n";
+  std::vector<std::filesystem::path> studies;
+  for (const auto& e : std::filesystem::directory_iterator(builtinStudyDir()))
+    if (e.path().extension() == ".toml") studies.push_back(e.path());
+  std::sort(studies.begin(), studies.end());
+  for (const auto& f : studies) {
+    std::string description;
+    try {
+      description = loadStudyFile(f).description;
+    } catch (const SceneError& e) {
+      description = std::string("(invalid: ") + e.what() + ")";
+    }
+    const std::string name = f.stem().string();
+    std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ') << description << "\n";
+  }
   return kExitOk;
 }
 
@@ -104,7 +119,7 @@ int runCli(int argc, const char* const* argv) {
   auto* check = app.add_subcommand("check", "Validate a scene and print its time-step audit without running");
   check->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", overrides, "Override a scene key")->take_all();
-  app.add_subcommand("list", "List the built-in scenes");
+  app.add_subcommand("list", "List the built-in scenes and studies");
   std::string camera_file;
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
   render->add_option("run", checkpoint_arg, "run.h5 written by an earlier run")->required();
