@@ -14,6 +14,7 @@
 #include <map>
 #include <ostream>
 #include <sstream>
+#include <cerrno>
 #include <thread>
 
 #include "atomic_file.h"
@@ -66,16 +67,19 @@ bool complete(const fs::path& results) {
   return !r.is_discarded() && r.is_object() && r.value("status", "") == "completed";
 }
 
-/// The last line of a log that says what went wrong ("error: ..."), else its last line.
+/// What went wrong, from a run's log: its last "error..." line (the watchdog's or the
+/// scene reader's message), else its last "rocklab: stopped/interrupted" line, else its
+/// last line.
 std::string lastError(const fs::path& log_file) {
   std::ifstream in(log_file);
-  std::string line, last, error;
+  std::string line, last, error, stopped;
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     last = line;
-    if (line.rfind("error", 0) == 0 || line.find("rocklab: stopped") != std::string::npos) error = line;
+    if (line.rfind("error", 0) == 0) error = line;
+    if (line.rfind("rocklab: stopped", 0) == 0 || line.rfind("rocklab: interrupted", 0) == 0) stopped = line;
   }
-  return error.empty() ? last : error;
+  return !error.empty() ? error : !stopped.empty() ? stopped : last;
 }
 
 void writeExit(const fs::path& set_dir, const std::string& name, int code) {
@@ -264,6 +268,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
   const std::string scene_path = fs::absolute(resolveScene(o.scene)).string();
   std::map<pid_t, const PlannedRun*> running;
   std::size_t next = 0;
+  auto last_line = std::chrono::steady_clock::now();
   auto progress = [&] {
     if (!o.progress) return;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -271,9 +276,8 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
     std::ostringstream line;
     line << "runs: " << done << "/" << todo.size() << " done, " << failed << " failed, " << running.size()
          << " running, " << jobs << " processes x 1 thread, elapsed " << clock(elapsed);
-    if (done > 0) line << ", ETA " << clock(elapsed / static_cast<double>(done) * static_cast<double>(left) /
-                                              std::max<std::size_t>(1, std::min<std::size_t>(jobs, left)) *
-                                              std::min<std::size_t>(jobs, todo.size()));
+    // Runs finish at the pool's pace: elapsed / done already counts the parallelism.
+    if (done > 0) line << ", ETA " << clock(elapsed / static_cast<double>(done) * static_cast<double>(left));
     log << line.str() << "\n";
   };
   while (next < todo.size() || !running.empty()) {
@@ -291,7 +295,15 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
     }
     if (running.empty()) break;
     int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
+    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    if (pid == 0) {  // none finished: a progress line every 30 s, so long runs are seen to go on
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      if (std::chrono::steady_clock::now() - last_line > std::chrono::seconds(30)) {
+        progress();
+        last_line = std::chrono::steady_clock::now();
+      }
+      continue;
+    }
     if (pid < 0) {
       if (errno == EINTR) continue;  // Ctrl-C: the children got it too; wait for them
       break;
@@ -304,6 +316,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
     if (std::ifstream ex{set_dir / "logs" / (r->name + ".exit")}; ex) ex >> code;
     finished(*r, code);
     progress();
+    last_line = std::chrono::steady_clock::now();
   }
   return stopRequested() ? kExitInterrupted : kExitOk;
 }

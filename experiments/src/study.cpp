@@ -47,6 +47,7 @@ std::string fixed(double v, int digits) {
 /// The sentence a user reads: which variant to take and what it costs.
 std::string recommendation(const StudyOptions& o, const StudyAnalysis& a, const std::string& reference_text) {
   std::ostringstream s;
+  if (!std::isfinite(a.reference)) return "no run completed with the figure: nothing to compare";
   if (!a.recommended) {
     s << "no variant is within " << o.tolerance_pct << " % of " << reference_text << "; refine further";
     return s.str();
