@@ -52,12 +52,21 @@ std::string folderName(const SweepOptions& o, const std::vector<std::string>& va
 }
 
 /// The rocklab executable the run lines call: ROCKLAB_EXE when set (tests that
-/// drive the CLI in-process set it), else this process's own executable.
+/// drive the CLI in-process set it), else this process's own executable, read once:
+/// a rebuild while a set runs replaces the file, and /proc/self/exe then names the
+/// old one "(deleted)"; the path itself is what later lines must call.
 fs::path selfExecutable() {
   if (const char* exe = std::getenv("ROCKLAB_EXE"); exe && *exe) return fs::absolute(exe);
-  std::error_code ec;
-  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path("rocklab") : p;
+  static const fs::path self = [] {
+    std::error_code ec;
+    std::string p = fs::read_symlink("/proc/self/exe", ec).string();
+    if (ec) return fs::path("rocklab");
+    const std::string deleted = " (deleted)";
+    if (p.size() > deleted.size() && p.compare(p.size() - deleted.size(), deleted.size(), deleted) == 0)
+      p.erase(p.size() - deleted.size());
+    return fs::path(p);
+  }();
+  return self;
 }
 
 bool complete(const fs::path& results) {

@@ -49,7 +49,8 @@ std::string recommendation(const StudyOptions& o, const StudyAnalysis& a, const 
   std::ostringstream s;
   if (!std::isfinite(a.reference)) return "no run completed with the figure: nothing to compare";
   if (!a.recommended) {
-    s << "no variant is within " << o.tolerance_pct << " % of " << reference_text << "; refine further";
+    s << "no variant is within " << o.tolerance_pct << (a.reference != 0.0 ? " % of " : " of ") << reference_text
+      << " together with all finer ones; refine further";
     return s.str();
   }
   const StudyPoint& best = a.points[*a.recommended];
@@ -58,9 +59,13 @@ std::string recommendation(const StudyOptions& o, const StudyAnalysis& a, const 
     s << " (the finest): no cheaper variant is within " << o.tolerance_pct << " % of it together with all finer ones";
     return s.str();
   }
-  s << ": " << o.figure << " " << fixed(best.figure, 6) << " is " << fixed(best.error_pct, 3) << " % from "
-    << reference_text << ", and so is every finer variant (tolerance " << o.tolerance_pct << " %), for "
-    << fixed(best.wall_s, 3) << " s of wall time";
+  s << ": " << o.figure << " " << fixed(best.figure, 6);
+  if (std::isfinite(best.error_pct))
+    s << " is " << fixed(best.error_pct, 3) << " % from " << reference_text << ", and so is every finer variant (tolerance "
+      << o.tolerance_pct << " %)";
+  else  // a reference of 0: the figure is an error itself, compared in its own unit
+    s << " is within " << o.tolerance_pct << " of " << reference_text << ", and so is every finer variant";
+  s << ", for " << fixed(best.wall_s, 3) << " s of wall time";
   double finest_wall = 0.0;
   for (const StudyPoint& p : a.points)
     if (p.ok) finest_wall = std::max(finest_wall, p.wall_s);
