@@ -78,24 +78,37 @@ std::string recommendation(const StudyOptions& o, const StudyAnalysis& a, const 
 /// log10(error %) against log10(wall time), the Pareto front joined.
 void writeStudyPlot(const StudyOptions& o, const StudyAnalysis& a, const std::string& name,
                     const std::filesystem::path& png) {
-  PlotSeries all{"variants", {}, {}, PlotSeries::Style::Points};
-  PlotSeries front{"Pareto front", {}, {}, PlotSeries::Style::LinePoints};
+  // Up to 6 variants each get a colour (the front takes the 7th) and their values in the legend; more share one series.
+  std::vector<PlotSeries> series;
+  PlotSeries front{"Pareto front", {}, {}, PlotSeries::Style::Line};  // over the coloured points
   std::vector<std::pair<double, double>> f;
   const bool relative = a.reference != 0.0;  // a reference of 0: the figure is an error already
+  std::size_t plotted = 0;
+  for (const StudyPoint& p : a.points) plotted += p.ok && !p.is_reference;
+  PlotSeries all{"variants", {}, {}, PlotSeries::Style::Points};
   for (const StudyPoint& p : a.points) {
     const double e = relative ? p.error_pct : p.error;
     if (!p.ok || p.is_reference || !(e > 0) || !(p.wall_s > 0)) continue;  // log scale: no zero error
-    all.x.push_back(std::log10(p.wall_s));
-    all.y.push_back(std::log10(e));
+    if (plotted <= 6) {
+      std::string label;
+      for (std::size_t k = 0; k < p.values.size(); ++k) label += (k ? ", " : "") + p.values[k];
+      series.push_back({label, {std::log10(p.wall_s)}, {std::log10(e)}, PlotSeries::Style::Points});
+    } else {
+      all.x.push_back(std::log10(p.wall_s));
+      all.y.push_back(std::log10(e));
+    }
     if (p.pareto) f.emplace_back(std::log10(p.wall_s), std::log10(e));
   }
+  if (!all.x.empty()) series.push_back(all);
   std::sort(f.begin(), f.end());
   for (const auto& [x, y] : f) front.x.push_back(x), front.y.push_back(y);
+  series.insert(series.begin(), front);  // drawn first, under the points
   PlotSpec spec;
-  spec.title = name + ": error of " + o.figure + " against run time";
+  spec.title = name + ": error of " + o.figure + " against run time (legend: " + o.runs.vary.front().first +
+               (o.runs.vary.size() > 1 ? ", ..." : "") + ")";
   spec.x_label = "log10 wall time (s)";
   spec.y_label = relative ? "log10 error (%)" : "log10 |" + o.figure + "|";
-  spec.series = {all, front};
+  spec.series = series;
   writePlot(spec, png);
 }
 
