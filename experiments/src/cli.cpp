@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -51,16 +52,18 @@ extern "C" void onSigint(int) {
 
 std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
 
-int doList() {
-  std::cout << "built-in scenes (" << builtinSceneDir().string() << "):\n";
+/// One line per TOML file of `dir`: its name and the first line of what `describe` says.
+void listFiles(const std::string& title, const std::filesystem::path& dir,
+               const std::function<std::string(const std::filesystem::path&)>& describe) {
+  std::cout << title << " (" << dir.string() << "):\n";
   std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(builtinSceneDir()))
+  for (const auto& e : std::filesystem::directory_iterator(dir))
     if (e.path().extension() == ".toml") files.push_back(e.path());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
     std::string description;
     try {
-      description = loadScene(f).run.description;
+      description = describe(f);
     } catch (const SceneError& e) {
       description = std::string("(invalid: ") + e.what() + ")";
     }
@@ -68,21 +71,12 @@ int doList() {
     std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ')
               << firstLine(description) << "\n";
   }
-  std::cout << "built-in studies (" << builtinStudyDir().string() << "; rocklab study NAME):\n";
-  std::vector<std::filesystem::path> studies;
-  for (const auto& e : std::filesystem::directory_iterator(builtinStudyDir()))
-    if (e.path().extension() == ".toml") studies.push_back(e.path());
-  std::sort(studies.begin(), studies.end());
-  for (const auto& f : studies) {
-    std::string description;
-    try {
-      description = loadStudyFile(f).description;
-    } catch (const SceneError& e) {
-      description = std::string("(invalid: ") + e.what() + ")";
-    }
-    const std::string name = f.stem().string();
-    std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ') << description << "\n";
-  }
+}
+
+int doList() {
+  listFiles("built-in scenes", builtinSceneDir(), [](const auto& f) { return loadScene(f).run.description; });
+  listFiles("built-in studies, rocklab study NAME", builtinStudyDir(),
+            [](const auto& f) { return loadStudyFile(f).description; });
   return kExitOk;
 }
 
