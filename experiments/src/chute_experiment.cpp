@@ -65,7 +65,7 @@ class ChuteExperiment final : public Experiment {
     for (const auto& s : scene.spheres) marker_radius_ = std::max(marker_radius_, s.radius);
   }
 
-  std::string trackingCamera() const override { return tracking_ ? e_.track_camera : std::string(); }
+  std::string trackingCamera() const override { return tracking_ ? e_.track_camera : std::string(); }  // read once at start
   void cameraFrame(std::uint64_t frame, double time, const cv::Mat& raw) override {
     if (tracking_ && !markers_.empty()) tracking_->addFrame(frame, time, raw);  // red exists once markers are chosen
   }
@@ -193,13 +193,20 @@ class ChuteExperiment final : public Experiment {
     // and knows how big its markers are and that they lie against that wall:
     // their centres one (equivalent) radius behind it.
     if (tracking_) {
-      if (e_.calibration_photos > 0) {
-        const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
-                                                    Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
-        tracking_->setCamera(cal.camera);
-        calibration_report_ = cal.report;
+      try {
+        if (e_.calibration_photos > 0) {
+          const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
+                                                      Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
+          tracking_->setCamera(cal.camera);
+          calibration_report_ = cal.report;
+        }
+        tracking_->setMarkers(marker_radius_, marker_radius_);
+      } catch (const std::exception& e) {
+        // No calibrated camera, no tracking: the run goes on for the DEM truth and
+        // results.json says why nothing was tracked.
+        tracking_error_ = std::string("camera calibration failed: ") + e.what();
+        tracking_.reset();
       }
-      tracking_->setMarkers(marker_radius_, marker_radius_);
     }
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
@@ -344,6 +351,7 @@ class ChuteExperiment final : public Experiment {
   std::unique_ptr<MarkerTracking> tracking_;
   CameraSettings track_settings_;      // the tracked camera as the renderer has it (takes the calibration photos)
   nlohmann::json calibration_report_;  // recovered against true camera (null: exact camera used)
+  std::string tracking_error_;         // why there is no tracking ("" = none or it ran)
   double marker_radius_ = 0.0;  // m
   bool has_top_ = false;
   Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
@@ -355,6 +363,10 @@ class ChuteExperiment final : public Experiment {
 /// to `markers`, writes tracks.csv and tracked_vs_truth.png; returns the summary.
 nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir,
                                                std::ostream& log) const {
+  if (!tracking_error_.empty()) {
+    log << "tracking: none (" << tracking_error_ << ")\n";
+    return {{"camera", e_.track_camera}, {"error", tracking_error_}};
+  }
   if (!tracking_ || markers_.empty()) return nullptr;
   const MarkerTracking::Result t = tracking_->finish();
   track::writeTracksCsv(out_dir / "tracks.csv", t.tracks, tracking_->camera(), tracking_->planePoint(), Vec3::UnitY());

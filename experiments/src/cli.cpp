@@ -38,7 +38,8 @@ Examples:
   rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
 
-Exit codes: 0 done, 2 bad input (nothing written), 3 stopped by the stability
+Exit codes: 0 done, 1 the run failed (its reason in results.json), 2 bad input
+(nothing written), 3 stopped by the stability
 watchdog, 4 a sweep or study finished but some runs failed (see its table),
 130 interrupted by Ctrl-C (outputs so far are kept and readable).
 Sweeps and studies run each variant as its own process of one thread, one per

@@ -121,10 +121,15 @@ class HeapExperiment final : public Experiment {
     nlohmann::json calibration;
     geometry::Camera camera = camera_.camera;
     if (e_.calibration_photos > 0) {
-      const WallCalibration cal =
-          calibrateOnWall(camera_.camera, renderOptionsFor(camera_), axis_point, towards_camera, e_.calibration_photos);
-      camera = cal.camera;
-      calibration = cal.report;
+      try {
+        const WallCalibration cal = calibrateOnWall(camera_.camera, renderOptionsFor(camera_), axis_point,
+                                                    towards_camera, e_.calibration_photos);
+        camera = cal.camera;
+        calibration = cal.report;
+      } catch (const std::exception& e) {  // no calibrated camera: no photograph angle, the rest stands
+        log << "heap: no angle from the photograph (camera calibration failed: " << e.what() << ")\n";
+        return {{"file", "heap_side.png"}, {"error", std::string("camera calibration failed: ") + e.what()}};
+      }
     }
     std::vector<double> xs, zs;
     for (int u = 0; u < photo_.cols; ++u)

@@ -274,6 +274,12 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     status = "failed";
     message = std::string("experiment phase switch: ") + e.what();
     exit_code = kExitBadInput;
+  } catch (const std::exception& e) {
+    // Anything else the experiment or an output met (a photograph it cannot read, a
+    // full disk): stop with the reason instead of aborting; outputs so far are kept.
+    status = "failed";
+    message = e.what();
+    exit_code = kExitFailed;
   }
   const auto t_loop_end = Clock::now();
   progress.finish();

@@ -157,6 +157,23 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   CHECK(fs::exists(dir / "profile.png"));
 }
 
+TEST_CASE("chute: a camera that cannot be calibrated leaves the run going and says why", "[experiment]") {
+  auto o = soft({"pebble", "steel", "perspex"}, 1e6);
+  o.push_back("particles.0.count=150");
+  o.push_back("particles.0.region_max=[0.6, 0.3, 0.1]");
+  o.push_back("experiment.marker_heights=[0.01]");
+  o.push_back("experiment.tilt_steps=200");
+  o.push_back("cameras.side.frame_rate=20");
+  o.push_back("cameras.side.movie=false");
+  o.push_back("cameras.side.target=[0.27, -1.5, 0.05]");  // looks away from the Perspex wall
+  const json r = runFor(kAssets + "chute-30-clumps.toml", o, "uncalibrated");
+  INFO(r.dump(2));
+  CHECK(r["status"] == "completed");
+  REQUIRE(r.contains("tracking"));
+  CHECK(r["tracking"]["error"].get<std::string>().find("camera calibration failed") != std::string::npos);
+  CHECK(r["markers"].size() == 5);  // the DEM truth is still there
+}
+
 TEST_CASE("chute: an outlet thinner than a clump jams and the run says so", "[experiment]") {
   auto o = soft({"pebble", "steel", "perspex"}, 1e6);
   o.push_back("particles.0.count=200");

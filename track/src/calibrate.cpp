@@ -28,8 +28,14 @@ cv::Mat toGrey(const cv::Mat& image) {
 std::vector<cv::Point2f> findCorners(const cv::Mat& image, cv::Size inner) {
   const cv::Mat grey = toGrey(image);
   std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCorners(grey, inner, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE))
-    return {};
+  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+  if (!cv::findChessboardCorners(grey, inner, corners, flags)) {
+    // Sensor noise breaks the detector's quads long before it moves the corners:
+    // find the grid on a smoothed copy, refine on the photograph itself.
+    cv::Mat smooth;
+    cv::GaussianBlur(grey, smooth, cv::Size(0, 0), 1.5);
+    if (!cv::findChessboardCorners(smooth, inner, corners, flags)) return {};
+  }
   // Search window: a little under half the smallest corner spacing (so it never
   // reaches the next corner), at most 11 px.
   double spacing = 1e9;

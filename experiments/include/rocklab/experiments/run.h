@@ -13,6 +13,7 @@ namespace rocklab::experiments {
 /// Exit codes of the CLI.
 enum ExitCode : int {
   kExitOk = 0,
+  kExitFailed = 1,       // the run stopped on an error that is not the input's (message in results.json)
   kExitBadInput = 2,     // scene, option or file the user gave is unusable; nothing written
   kExitWatchdog = 3,     // the stability watchdog stopped the run; outputs so far kept
   kExitRunsFailed = 4,   // a multi-run command finished, but some of its runs failed (see its table)
