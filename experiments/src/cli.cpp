@@ -138,6 +138,17 @@ int runCli(int argc, const char* const* argv) {
     c->add_option("--slurm-mem", slurm.memory, "Slurm memory per run (with --plan)")->capture_default_str();
     c->add_option("--slurm-partition", slurm.partition, "Slurm partition (with --plan; default: the cluster's)");
   };
+  // What --out, --threads, --quiet and the set options above ask of a sweep or study.
+  auto applySetOptions = [&](SweepOptions& so) {
+    if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
+      throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
+    so.out_dir = plan_dir.empty() ? out_dir : plan_dir;
+    so.plan_only = !plan_dir.empty();
+    so.jobs = jobs;
+    so.slurm = slurm;
+    so.threads = threads;
+    so.progress = !quiet;
+  };
   auto addSweepOptions = [&](CLI::App* c) {
     c->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
     c->add_option("--vary", vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
@@ -235,14 +246,7 @@ int runCli(int argc, const char* const* argv) {
           throw std::invalid_argument("--reference '" + reference + "': give finest or a number (a lab value)");
       }
       if (tolerance > 0) so.tolerance_pct = tolerance;
-      so.runs.jobs = jobs;
-      so.runs.slurm = slurm;
-      so.runs.plan_only = !plan_dir.empty();
-      if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
-        throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
-      so.runs.out_dir = plan_dir.empty() ? out_dir : plan_dir;
-      so.runs.threads = threads;
-      so.runs.progress = !quiet;
+      applySetOptions(so.runs);
       return runStudy(so, std::cerr);
     } catch (const std::exception& e) {
       std::cerr << "error: " << e.what() << "\n";
@@ -261,12 +265,7 @@ int runCli(int argc, const char* const* argv) {
     try {
       for (const std::string& v : vary) so.vary.push_back(parseVary(v));
       if (app.got_subcommand("sweep")) {
-        so.jobs = jobs;
-        so.slurm = slurm;
-        so.plan_only = !plan_dir.empty();
-        if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
-          throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
-        if (!plan_dir.empty()) so.out_dir = plan_dir;
+        applySetOptions(so);
         return runSweep(so, std::cerr);
       }
       CalibrateOptions co;

@@ -196,37 +196,35 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   writeAtomically(dir / "README.md", rd.str());
 }
 
-Variant inspectRun(const fs::path& set_dir, const PlannedRun& run, std::string* error) {
-  Variant v;
-  v.values = run.values;
-  const fs::path results = set_dir / "runs" / run.name / "results.json";
-  if (complete(results)) {
-    std::ifstream in(results);
-    v.results = json::parse(in, nullptr, false);
-    v.code = kExitOk;
-    return v;
-  }
-  std::ifstream in(results);  // a stopped run's results (watchdog, Ctrl-C) still tell something
-  if (in) v.results = json::parse(in, nullptr, false);
-  if (v.results.is_discarded()) v.results = nullptr;
-  int code = kMissing;
-  if (std::ifstream ex{set_dir / "logs" / (run.name + ".exit")}; ex) ex >> code;
-  if (code == kExitOk) code = 1;  // exited 0 without a complete results.json: not a success
-  v.code = code;
-  if (error) *error = code == kMissing ? std::string() : lastError(set_dir / "logs" / (run.name + ".log"));
-  return v;
-}
-
-std::string failureStatus(int code, const std::string& error) {
-  if (code == kMissing) return "missing";
-  std::string s = "exit " + std::to_string(code);
-  if (!error.empty()) {
+std::vector<Variant> inspectRuns(const fs::path& set_dir, const std::vector<PlannedRun>& runs) {
+  std::vector<Variant> out;
+  for (const PlannedRun& run : runs) {
+    Variant& v = out.emplace_back();
+    v.values = run.values;
+    const fs::path results = set_dir / "runs" / run.name / "results.json";
+    // A stopped run's results (watchdog, Ctrl-C) still tell something.
+    if (std::ifstream in(results); in) v.results = json::parse(in, nullptr, false);
+    if (v.results.is_discarded()) v.results = nullptr;
+    if (v.results.is_object() && v.results.value("status", "") == "completed") {
+      v.code = kExitOk;
+      v.status = "ok";
+      continue;
+    }
+    int code = kMissing;
+    if (std::ifstream ex{set_dir / "logs" / (run.name + ".exit")}; ex) ex >> code;
+    if (code == kExitOk) code = 1;  // exited 0 without a complete results.json: not a success
+    v.code = code;
+    if (code == kMissing) {
+      v.status = "missing";
+      continue;
+    }
+    const std::string error = lastError(set_dir / "logs" / (run.name + ".log"));
     std::string e = error.rfind("error: ", 0) == 0 ? error.substr(7) : error;
     e = e.substr(0, 160);
     std::replace(e.begin(), e.end(), ',', ';');  // the table is CSV
-    s += ": " + e;
+    v.status = "exit " + std::to_string(code) + (e.empty() ? "" : ": " + e);
   }
-  return s;
+  return out;
 }
 
 int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vector<PlannedRun>& runs, std::ostream& log) {

@@ -47,13 +47,11 @@ void writePlanFiles(const std::filesystem::path& set_dir, const SweepOptions& o,
 int executeRuns(const std::filesystem::path& set_dir, const SweepOptions& o, const std::vector<PlannedRun>& runs,
                 std::ostream& log);
 
-/// What a run left: results.json when complete (code 0); else its exit code and the
-/// last error line of its log; code kMissing when it never ran.
+/// What each run left: results.json when complete (code 0, status "ok"); else its
+/// exit code and status "exit N: <the last error line of its log>"; code kMissing and
+/// status "missing" when it never ran.
 constexpr int kMissing = -1;
-Variant inspectRun(const std::filesystem::path& set_dir, const PlannedRun& run, std::string* error = nullptr);
-
-/// A table cell for a run that did not complete: "exit 3: <message>" or "missing".
-std::string failureStatus(int code, const std::string& error);
+std::vector<Variant> inspectRuns(const std::filesystem::path& set_dir, const std::vector<PlannedRun>& runs);
 
 /// The number of processes for --jobs when not given: the cores.
 int defaultJobs();

@@ -1,5 +1,6 @@
 #include "run_set.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -111,6 +112,10 @@ double toDouble(const std::string& text, const std::string& what) {
   } catch (const std::exception&) {
     throw std::invalid_argument(what + ": '" + text + "' is not a number");
   }
+}
+
+bool allOk(const std::vector<Variant>& variants) {
+  return std::all_of(variants.begin(), variants.end(), [](const Variant& v) { return v.code == kExitOk; });
 }
 
 void writeTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,

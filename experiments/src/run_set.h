@@ -19,6 +19,7 @@ struct Variant {
   std::vector<std::string> values;
   nlohmann::json results;
   int code = kExitOk;
+  std::string status;  // table cell: "ok", "exit 3: <its error>", "missing" ("" = from code)
 };
 
 /// Every combination of the varied values, the first key slowest.
@@ -40,6 +41,8 @@ std::string cell(const nlohmann::json& v);
 double number(const nlohmann::json& v);
 /// Parses a whole string as a finite number; throws std::invalid_argument naming `what`.
 double toDouble(const std::string& text, const std::string& what);
+/// True when every variant ended normally.
+bool allOk(const std::vector<Variant>& variants);
 /// Writes the table as CSV (atomically) and prints it aligned.
 void writeTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
                 const std::filesystem::path& csv_path, std::ostream& log);

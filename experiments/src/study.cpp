@@ -156,21 +156,17 @@ namespace {
 
 /// The study's table, study.json, plot and recommendation from what its runs left.
 int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const std::vector<PlannedRun>& runs,
-                const std::string& name, std::ostream& log) {
+                const std::vector<Variant>& done, const std::string& name, std::ostream& log) {
   std::vector<StudyPoint> points;
   std::vector<std::string> status;
-  bool all_ok = true;
-  for (const PlannedRun& r : runs) {
-    std::string error;
-    const Variant v = inspectRun(dir, r, &error);
+  for (const Variant& v : done) {
     StudyPoint p;
     p.values = v.values;
     p.figure = number(lookup(v.results, o.figure));
     p.wall_s = number(lookup(v.results, "wall_time_s.total"));
     p.ok = v.code == kExitOk && std::isfinite(p.figure);
     points.push_back(p);
-    status.push_back(v.code != kExitOk ? failureStatus(v.code, error) : p.ok ? "ok" : "no figure");
-    all_ok = all_ok && v.code == kExitOk;
+    status.push_back(v.code != kExitOk ? v.status : p.ok ? "ok" : "no figure");
   }
   const StudyAnalysis a = analyseStudy(points, o.reference, o.tolerance_pct);
   const std::string reference_text =
@@ -213,7 +209,7 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
               {"variants", rows_json},
               {"recommended", a.recommended ? json("runs/" + runs[*a.recommended].name) : json(nullptr)},
               {"recommendation", line},
-              {"complete", all_ok}};
+              {"complete", allOk(done)}};
   writeAtomically(dir / "study.json", out.dump(2) + "\n");
   try {
     writeStudyPlot(o, a, name, dir / "study.png");
@@ -221,7 +217,7 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
     log << "study: no plot (" << e.what() << ")\n";
   }
   log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << "\n";
-  return all_ok ? kExitOk : kExitRunsFailed;
+  return allOk(done) ? kExitOk : kExitRunsFailed;
 }
 
 }  // namespace
@@ -260,21 +256,21 @@ int runStudy(const StudyOptions& o, std::ostream& log) {
     return kExitOk;
   }
   const int code = executeRuns(dir, o.runs, runs, log);
-  const int report = reportStudy(dir, o, runs, first.run.name, log);
+  const int report = reportStudy(dir, o, runs, inspectRuns(dir, runs), first.run.name, log);
   return code != kExitOk ? code : report;
 }
 
 namespace detail {
 
 int collectStudy(const std::filesystem::path& dir, const SweepOptions& runs_options, const json& plan,
-                 const std::vector<PlannedRun>& runs, std::ostream& log) {
+                 const std::vector<PlannedRun>& runs, const std::vector<Variant>& done, std::ostream& log) {
   StudyOptions o;
   o.runs = runs_options;
   o.figure = plan.value("figure", "");
   if (plan.contains("reference") && plan["reference"].is_number()) o.reference = plan["reference"].get<double>();
   o.tolerance_pct = plan.value("tolerance_pct", o.tolerance_pct);
   o.description = plan.value("description", "");
-  return reportStudy(dir, o, runs, std::filesystem::path(o.runs.scene).stem().string(), log);
+  return reportStudy(dir, o, runs, done, std::filesystem::path(o.runs.scene).stem().string(), log);
 }
 
 }  // namespace detail

@@ -9,8 +9,9 @@
 
 namespace rocklab::experiments::detail {
 
-/// Table, plot and recommendation of a study set from plan.json and its runs.
+/// Table, plot and recommendation of a study set from plan.json and what its runs
+/// left (inspectRuns).
 int collectStudy(const std::filesystem::path& dir, const SweepOptions& runs_options, const nlohmann::json& plan,
-                 const std::vector<PlannedRun>& runs, std::ostream& log);
+                 const std::vector<PlannedRun>& runs, const std::vector<Variant>& done, std::ostream& log);
 
 }  // namespace rocklab::experiments::detail

@@ -37,23 +37,18 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   return m;
 }
 
-/// The sweep's table: the varied values, the chosen figures, how each run ended
-/// (`status`: one per point; empty = "ok" or "exit N" from the point's code).
+/// The sweep's table: the varied values, the chosen figures, how each run ended.
 void writeMetricTable(const SweepOptions& o, const std::vector<std::string>& metrics, const std::vector<Variant>& points,
-                      const std::filesystem::path& csv_path, std::ostream& log,
-                      const std::vector<std::string>& status = {}) {
+                      const std::filesystem::path& csv_path, std::ostream& log) {
   std::vector<std::string> header;
   for (const auto& [key, values] : o.vary) header.push_back(key);
   for (const auto& m : metrics) header.push_back(m);
   header.push_back("status");
   std::vector<std::vector<std::string>> rows;
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const Variant& p = points[k];
+  for (const Variant& p : points) {
     std::vector<std::string> row = p.values;
     for (const auto& m : metrics) row.push_back(cell(lookup(p.results, m)));
-    row.push_back(k < status.size() && !status[k].empty() ? status[k]
-                  : p.code == kExitOk                     ? "ok"
-                                                          : "exit " + std::to_string(p.code));
+    row.push_back(!p.status.empty() ? p.status : p.code == kExitOk ? "ok" : "exit " + std::to_string(p.code));
     rows.push_back(row);
   }
   writeTable(header, rows, csv_path, log);
@@ -85,19 +80,11 @@ std::pair<std::string, std::vector<std::string>> parseVary(const std::string& as
 
 namespace {
 
-/// The sweep's table and plot from what its runs left (in-process, processes or collect).
+/// The sweep's table and plot from what its runs left (inspectRuns: in-process,
+/// processes or collect).
 int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const std::vector<std::string>& metrics,
-                const std::vector<PlannedRun>& runs, const std::string& name, std::ostream& log) {
-  std::vector<Variant> done;
-  std::vector<std::string> status;
-  bool all_ok = true;
-  for (const PlannedRun& r : runs) {
-    std::string error;
-    done.push_back(inspectRun(dir, r, &error));
-    status.push_back(done.back().code == kExitOk ? "ok" : failureStatus(done.back().code, error));
-    all_ok = all_ok && done.back().code == kExitOk;
-  }
-  writeMetricTable(o, metrics, done, dir / "sweep.csv", log, status);
+                const std::vector<Variant>& done, const std::string& name, std::ostream& log) {
+  writeMetricTable(o, metrics, done, dir / "sweep.csv", log);
   // Plot: the first metric against the first key; one series per value of the second key.
   PlotSpec spec;
   spec.title = name + ": " + metrics.front() + " against " + o.vary.front().first;
@@ -124,7 +111,7 @@ int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const s
     log << "sweep: no plot (" << e.what() << ")\n";
   }
   log << "sweep: table " << (dir / "sweep.csv").string() << ", plot " << (dir / "sweep.png").string() << "\n";
-  return all_ok ? kExitOk : kExitRunsFailed;
+  return allOk(done) ? kExitOk : kExitRunsFailed;
 }
 
 }  // namespace
@@ -154,7 +141,7 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
     return kExitOk;
   }
   const int code = executeRuns(dir, o, runs, log);
-  const int report = reportSweep(dir, o, metrics, runs, first.run.name, log);
+  const int report = reportSweep(dir, o, metrics, inspectRuns(dir, runs), first.run.name, log);
   return code != kExitOk ? code : report;
 }
 
@@ -174,17 +161,15 @@ int collectSet(const std::filesystem::path& dir, std::ostream& log) {
   for (const json& r : plan["runs"])
     runs.push_back({r["name"].get<std::string>(), r["values"].get<std::vector<std::string>>(),
                     r["overrides"].get<std::vector<std::string>>(), r.value("invalid", "")});
+  const std::vector<Variant> done = inspectRuns(dir, runs);
   std::size_t complete = 0, failed = 0, missing = 0;
-  for (const PlannedRun& r : runs) {
-    const Variant v = inspectRun(dir, r);
-    (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
-  }
+  for (const Variant& v : done) (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
   const std::string kind = plan.value("kind", "");
   const std::string name = std::filesystem::path(o.scene).stem().string();
   log << "collect " << kind << " of " << name << ": " << complete << " complete, " << failed << " failed, " << missing
       << " missing of " << runs.size() << " runs\n";
-  if (kind == "sweep") return reportSweep(dir, o, plan["metrics"].get<std::vector<std::string>>(), runs, name, log);
-  if (kind == "study") return collectStudy(dir, o, plan, runs, log);
+  if (kind == "sweep") return reportSweep(dir, o, plan["metrics"].get<std::vector<std::string>>(), done, name, log);
+  if (kind == "study") return collectStudy(dir, o, plan, runs, done, log);
   log << "error: collect: " << (dir / "plan.json").string() << ": unknown kind '" << kind << "'\n";
   return kExitBadInput;
 }

@@ -65,18 +65,26 @@ TEST_CASE("damped cap: the old step (0.5 x critical) on the 1e4 fragment", "[sta
 
 namespace {
 
-void fragmentRidingWall(std::uint64_t steps, const std::string& name) {
-  // The wall (the crusher's stiffness, infinitely heavy) moves z = A sin(2 pi f t)
-  // with A f^2 (2 pi)^2 = 3.2 m/s^2 < g: the fragment must ride it, never leave it.
+/// A 4 mm fragment's world: 1e9 N/m fragment, a 1e13 N/m table (the crusher's
+/// stiffness, infinitely heavy) oscillating z = kWallAmplitude sin(2 pi kWallFrequency t)
+/// with A f^2 (2 pi)^2 = 3.2 m/s^2 < g, gravity, beta = 0.11.
+constexpr double kWallAmplitude = 2e-6, kWallFrequency = 200.0;
+sim::Model fragmentOnOscillatingWall() {
   sim::Model model = linearPair(1e9, 0.37, 0.11);
   model.materials[0].kn = model.materials[0].ks = 1e9;
   model.materials[1].kn = model.materials[1].ks = 1e13;
   model.gravity = Vec3(0, 0, -9.81);
   sim::Wall table = squareZ("table", Vec3::Zero(), 0.05);
-  const double A = 2e-6, f = 200.0;
-  table.motion.amplitude = Vec3(0, 0, A);
-  table.motion.frequency = f;
+  table.motion.amplitude = Vec3(0, 0, kWallAmplitude);
+  table.motion.frequency = kWallFrequency;
   model.walls.push_back(table);
+  return model;
+}
+
+void fragmentRidingWall(std::uint64_t steps, const std::string& name) {
+  // The fragment must ride the wall, never leave it.
+  const sim::Model model = fragmentOnOscillatingWall();
+  const double A = kWallAmplitude, f = kWallFrequency;
   const double r = kFragment, k = 1e9 * 1e13 / (1e9 + 1e13), m = sphereMass(r);
   const double rest = m * 9.81 / k;
   const double w_peak = A * 2 * std::numbers::pi * f;
@@ -214,16 +222,8 @@ namespace {
 
 /// The 4 mm fragment riding the 1e13 N/m wall at 200 Hz with dt forced to f x critical.
 Outcome fragmentOnWallForced(double f, double& w_peak) {
-  sim::Model model = linearPair(1e9, 0.37, 0.11);
-  model.materials[0].kn = model.materials[0].ks = 1e9;
-  model.materials[1].kn = model.materials[1].ks = 1e13;
-  model.gravity = Vec3(0, 0, -9.81);
-  sim::Wall table = squareZ("table", Vec3::Zero(), 0.05);
-  const double A = 2e-6, fr = 200.0;
-  w_peak = A * 2 * std::numbers::pi * fr;
-  table.motion.amplitude = Vec3(0, 0, A);
-  table.motion.frequency = fr;
-  model.walls.push_back(table);
+  sim::Model model = fragmentOnOscillatingWall();
+  w_peak = kWallAmplitude * 2 * std::numbers::pi * kWallFrequency;
   const double r = kFragment;
   const std::vector<sim::SphereSpec> s{ball({0, 0, r}, r, {0, 0, w_peak})};
   model.timestep.dt = f * sim::World(model, s, 1).timestepAudit().critical;
