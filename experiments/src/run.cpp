@@ -327,8 +327,13 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
                    {"rayleigh_s", audit.rayleigh},
                    {"hertz_contact_time_s", audit.hertz_contact_time},
                    {"linear_contact_time_s", audit.linear_contact_time},
+                   {"damped_limit_s", audit.damped_limit},
                    {"automatic_s", audit.automatic},
-                   {"dt_over_critical", dt / audit.critical}};
+                   {"dt_over_critical", dt / audit.critical},
+                   // Largest dt / stable step of the contact network seen by the watchdog
+                   // (stops above 1), in the world of the last phase of an experiment.
+                   {"network_step_ratio_max", world->stats().network_step_ratio},
+                   {"network_checks", world->stats().network_checks}};
   r["wall_time_s"] = {{"setup", seconds(t_start, t_setup)},
                       {"stepping", stepping},
                       {"output", output_seconds},

@@ -599,6 +599,12 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
         t->number("max_energy_growth", model.watchdog.max_energy_growth, Range::nonNegative());
     model.watchdog.check_interval = static_cast<int>(
         t->integer("check_interval", model.watchdog.check_interval, Range::closed(1, 1e9)));
+    model.watchdog.network_iterations = static_cast<int>(
+        t->integer("network_iterations", model.watchdog.network_iterations, Range::closed(0, 1000)));
+    t->finish();
+  }
+  if (auto t = root.table("relaxation")) {
+    model.relaxation.steps = static_cast<int>(t->integer("steps", 0, Range::closed(0, 1e9)));
     t->finish();
   }
 

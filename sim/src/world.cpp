@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "contact_kernel.h"
+#include "contact_spectrum.h"
 #include "neighbor_list.h"
 #include "rigid_body.h"
 #include "wall_runtime.h"
@@ -112,6 +113,8 @@ struct World::Impl {
   // not depend on the number of threads.
   std::vector<double> wall_work, wall_work_gross;
   std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
+  // Highest frequency of the contact network (step check), kept between checks.
+  detail::SpectrumEstimate spectrum;
 
   // Below this many balls per thread a second thread does not pay: a step of a
   // few thousand balls takes tens of microseconds, and waking the team, the
@@ -141,6 +144,8 @@ struct World::Impl {
   void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
   void checkEnergy(const Energy& e);
+  template <class Law> detail::ContactNetwork contactNetwork() const;
+  void checkNetworkStep();
   void startRelaxation();
   void updateRelaxation();
   bool energyCheckApplies() const;
@@ -950,6 +955,111 @@ void World::Impl::checkEnergy(const Energy& e) {
   throw WatchdogError(s.str());
 }
 
+// The touching contacts as springs between rigid bodies (free balls and clumps),
+// for the step check. A shear spring counts only while it sticks.
+template <class Law>
+detail::ContactNetwork World::Impl::contactNetwork() const {
+  detail::ContactNetwork net;
+  const std::size_t n = p.size();
+  const ClumpState& k = p.clumps;
+  std::vector<std::int32_t> body_of(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (isMember(i)) continue;
+    body_of[i] = static_cast<std::int32_t>(net.bodies.size());
+    const double inertia = 1.0 / p.inv_inertia[i];
+    net.bodies.push_back({p.inv_mass[i], inertia * geometry::Mat3::Identity(),
+                          p.inv_inertia[i] * geometry::Mat3::Identity()});
+  }
+  const auto first_clump = static_cast<std::int32_t>(net.bodies.size());
+  for (std::size_t c = 0; c < k.size(); ++c) {
+    const geometry::Mat3 r = k.orientation[c].toRotationMatrix();
+    net.bodies.push_back({1.0 / k.mass[c], r * k.inertia[c].asDiagonal() * r.transpose(),
+                          r * k.inertia[c].cwiseInverse().asDiagonal() * r.transpose()});
+  }
+  if (has_clumps)
+    for (std::size_t i = 0; i < n; ++i)
+      if (isMember(i)) body_of[i] = first_clump + p.clump[i];
+  auto centre = [&](std::size_t i) { return isMember(i) ? k.position[p.clump[i]] : p.position[i]; };
+  const ContactModel& cm = model.contact;
+  auto add = [&](std::size_t i, std::int32_t b, const Vec3& normal, const Vec3& cp, const Vec3& centre_b,
+                 double overlap, double r_tilde, double damping_mass, const PairProps& props, const Vec3& shear) {
+    double secant, tangent;
+    Law::normal(props, overlap, r_tilde, secant, tangent);
+    const double fn = secant * overlap;
+    const double limit = props.friction * fn;
+    const bool sticks = shear.squaredNorm() < limit * limit * (1.0 - 1e-9);
+    detail::NetworkContact c;
+    c.a = body_of[i];
+    c.b = b;
+    c.normal = normal;
+    c.lever_a = cp - centre(i);
+    c.lever_b = cp - centre_b;
+    c.kn = tangent;
+    c.ks = sticks ? Law::shear(props, fn, r_tilde) : 0.0;
+    // The dashpots of evaluateContact (Eq 2-16..2-18); the shear one only while sticking.
+    c.cn = 2.0 * cm.damping_normal * std::sqrt(damping_mass * c.kn);
+    c.cs = 2.0 * cm.damping_shear * std::sqrt(damping_mass * c.ks);
+    net.contacts.push_back(c);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const double ri = p.radius[i];
+    for (std::uint32_t q = pairs.row_offset[i]; q < pairs.row_offset[i + 1]; ++q) {
+      if (!pair_touch[q]) continue;
+      const std::uint32_t j = pairs.partner[q];
+      if (body_of[i] == body_of[j]) continue;  // members of one clump
+      const Vec3 d = p.position[j] - p.position[i];
+      const double dist = d.norm(), rj = p.radius[j];
+      const Vec3 normal = dist > 0 ? Vec3(d / dist) : Vec3(Vec3::UnitZ());
+      double overlap = ri + rj - dist;
+      const Vec3 cp = p.position[i] + normal * (ri - 0.5 * overlap);
+      if (relaxing()) overlap -= relax_factor * pair_relax[q];
+      if (overlap <= 0) continue;
+      const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
+      const double mi = p.mass[i], mj = p.mass[j];
+      const double md = cm.damping_mass == DampingMass::Average ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
+      add(i, body_of[j], normal, cp, centre(j), overlap, 2.0 * ri * rj / (ri + rj), md, props, pair_shear[q]);
+    }
+    for (std::uint32_t w = wall_offset[i]; w < wall_offset[i + 1]; ++w) {
+      if (!wall_touch[w]) continue;
+      const std::uint32_t wk = wall_index[w];
+      detail::WallContact wc;
+      if (!walls[wk].active || !walls[wk].contact(model.walls[wk], p.position[i], ri, wc)) continue;
+      const Vec3 cp = p.position[i] + wc.normal * (ri - 0.5 * wc.overlap);
+      const double overlap = wc.overlap - (relaxing() ? relax_factor * wall_relax[w] : 0.0);
+      if (overlap <= 0) continue;
+      const PairProps& props =
+          ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wk].material)];
+      add(i, -1, wc.normal, cp, cp, overlap, ri, p.mass[i], props, wall_shear[w]);
+    }
+  }
+  return net;
+}
+
+void World::Impl::checkNetworkStep() {
+  if (model.watchdog.network_iterations <= 0) return;
+  const detail::ContactNetwork net = model.contact.law == ContactLaw::Linear
+                                         ? contactNetwork<detail::LinearLaw>()
+                                         : contactNetwork<detail::HertzMindlinLaw>();
+  detail::iterateSpectrum(net, 2.0 / dt, model.watchdog.network_iterations, spectrum);
+  // Stable while L < 4 / dt^2 (contact_spectrum.h): the ratio dt / (2 / sqrt(L)).
+  const double ratio = 0.5 * dt * std::sqrt(spectrum.eigenvalue);
+  ++stats.network_checks;
+  stats.network_step_ratio = std::max(stats.network_step_ratio, ratio);
+  if (ratio <= 1.0) return;
+  const double omega = std::sqrt(spectrum.stiffness);
+  const double stable = detail::stableStep(spectrum.stiffness, spectrum.damping);
+  std::ostringstream s;
+  s << "watchdog: at t = " << fmtNum(time) << " s (step " << step << ") the step is unstable for the contact "
+    << "network: its fastest mode (" << net.contacts.size() << " touching contacts; largest share on body "
+    << spectrum.body << ") has omega = " << fmtNum(omega) << " rad/s and dashpots " << fmtNum(spectrum.damping)
+    << " 1/s, stable only for dt < " << fmtNum(stable) << " s (" << fmtNum(stable / audit.critical)
+    << " x critical). Sticking contacts would creep and slip without a blow-up, unseen by the energy check. "
+       "The critical step counts one contact per body; a body pressed by several, a stuck shear spring that "
+       "also turns it, and their dashpots make it vibrate faster (ref §7a). "
+    << stepAdvice();
+  throw WatchdogError(s.str());
+}
+
 // ---------------------------------------------------------------------------
 // One step
 
@@ -1007,6 +1117,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     // observer may end the run (a drop test ends at the rebound) before the next
     // scheduled check would see a blow-up.
     if (energyCheckApplies()) checkEnergy(s.energy);
+    if (energy_due) checkNetworkStep();
     if (observer) {
       std::vector<Vec3> total(n);  // total force including gravity
       for (std::size_t i = 0; i < n; ++i) total[i] = acc_force[i] + gravity * (isMember(i) ? 0.0 : p.mass[i]);

@@ -105,7 +105,7 @@ TEST_CASE("clump: members never push each other apart", "[clump]") {
   // The four members overlap by half a diameter; without the pair exclusion the
   // clump would be pushed apart or spun up at the first step.
   auto model = test::linearModel(1e9);
-  model.timestep.dt = 1e-6;
+  model.timestep.dt = 9e-7;
   sim::World w(model, {}, {fourBall(0.00735, 2730, Vec3::Zero())}, 1);
   for (int k = 0; k < 100; ++k) w.step();
   CHECK(w.particles().clumps.velocity[0].norm() == 0.0);

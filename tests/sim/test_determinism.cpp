@@ -41,17 +41,17 @@ TEST_CASE("bitwise identical on 1 and 2 threads", "[determinism]") {
 TEST_CASE("restart from a checkpoint continues bit for bit", "[determinism]") {
   const auto s = lattice(8, 8, 6);
   sim::World full(heapModel(), s, 1);
-  for (int k = 0; k < 3000; ++k) full.step();
+  for (int k = 0; k < 5000; ++k) full.step();
 
   sim::World first(heapModel(), s, 1);
-  for (int k = 0; k < 1234; ++k) first.step();
+  for (int k = 0; k < 2634; ++k) first.step();
   const auto path = std::filesystem::temp_directory_path() / "rocklab-restart-test.h5";
   sim::output::writeCheckpoint(path, first.exportState(), "scene text");
   auto cp = sim::output::readCheckpoint(path);
   std::filesystem::remove(path);
   REQUIRE(!cp.state.pair_history.empty());  // the history really is carried
   sim::World second(heapModel(), std::move(cp.state), 1);
-  while (second.stepCount() < 3000) second.step();
+  while (second.stepCount() < 5000) second.step();
   CHECK(second.stateHash() == full.stateHash());
   CHECK(second.time() == full.time());
 }

@@ -47,7 +47,7 @@ TEST_CASE("audit: automatic step - scene may only lower it", "[timestep]") {
   const double m = 2730 * 4.0 / 3.0 * std::numbers::pi * 1e-6;
   // Stiffest partner: 2e9 in series with 2e9 = 1e9 N/m; rotation limits.
   CHECK_THAT(w.timestepAudit().critical, WithinRel(std::sqrt(0.4 * m / 1e9), 1e-12));
-  CHECK_THAT(w.dt(), WithinRel(0.5 * w.timestepAudit().critical, 1e-12));
+  CHECK_THAT(w.dt(), WithinRel(sim::TimestepSettings{}.safety_factor * w.timestepAudit().critical, 1e-12));
 
   model.timestep.dt = 1e-3;
   CHECK_THROWS_WITH(sim::World(model, s, 1), Catch::Contains("timestep.dt = 0.001 s is larger than the automatic step"));

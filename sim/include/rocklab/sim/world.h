@@ -67,6 +67,8 @@ struct WorldStats {
   std::size_t pairs_in_list = 0;
   std::size_t wall_candidates = 0;
   double neighbour_seconds = 0.0;  // s of wall time spent in neighbour-list rebuilds
+  std::uint64_t network_checks = 0;  // step checks of the contact network done
+  double network_step_ratio = 0.0;   // largest dt / (stable step of the network) they found; stops above 1
 };
 
 class World {

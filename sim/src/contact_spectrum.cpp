@@ -1,0 +1,128 @@
+#include "contact_spectrum.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rocklab::sim::detail {
+
+namespace {
+
+/// Fixed pseudo-random start in [-1, 1] (splitmix64): the same on every run and
+/// thread count, with a component along every mode.
+double startValue(std::uint64_t k) {
+  std::uint64_t z = (k + 1) * 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
+}
+
+Vec3 part(const std::vector<double>& x, std::size_t body, int which) {
+  const std::size_t o = 6 * body + 3 * static_cast<std::size_t>(which);
+  return {x[o], x[o + 1], x[o + 2]};
+}
+
+void addPart(std::vector<double>& x, std::size_t body, int which, const Vec3& v) {
+  const std::size_t o = 6 * body + 3 * static_cast<std::size_t>(which);
+  x[o] += v.x();
+  x[o + 1] += v.y();
+  x[o + 2] += v.z();
+}
+
+/// Kinetic-energy norm x^T M x of one body's part of x.
+double massNorm(const NetworkBody& b, const Vec3& t, const Vec3& r) {
+  return t.squaredNorm() / b.inv_mass + r.dot(b.inertia * r);
+}
+
+}  // namespace
+
+double stableStep(double stiffness, double damping) {
+  return 4.0 / (damping + std::sqrt(damping * damping + 4.0 * stiffness));
+}
+
+void iterateSpectrum(const ContactNetwork& network, double damping_weight, int iterations,
+                     SpectrumEstimate& estimate) {
+  const std::size_t n = network.bodies.size();
+  std::vector<double>& x = estimate.vector;
+  if (x.size() != 6 * n) {
+    x.assign(6 * n, 0.0);
+  } else {
+    // Scale the kept vector to a unit M-norm before mixing (below).
+    double norm = 0.0;
+    for (std::size_t i = 0; i < n; ++i) norm += massNorm(network.bodies[i], part(x, i, 0), part(x, i, 1));
+    const double scale = norm > 0 ? 1.0 / std::sqrt(norm) : 0.0;
+    for (double& v : x) v *= scale;
+  }
+  // Mix in a little of a fresh pseudo-random vector (a different one at every
+  // call): a kept vector that is exactly a mode of an earlier network (a contact
+  // that slid, so had no shear spring) has no component along a mode that
+  // appeared since, and power iteration alone would never find it.
+  const std::uint64_t offset = 6 * n * (estimate.calls++ + 1);
+  double fresh = 0.0;
+  std::vector<double> r(6 * n);
+  for (std::size_t k = 0; k < r.size(); ++k) r[k] = startValue(offset + k);
+  for (std::size_t i = 0; i < n; ++i) fresh += massNorm(network.bodies[i], part(r, i, 0), part(r, i, 1));
+  const double weight = (x.empty() || std::all_of(x.begin(), x.end(), [](double v) { return v == 0.0; }) ? 1.0 : 0.01) /
+                        std::sqrt(fresh);
+  for (std::size_t k = 0; k < x.size(); ++k) x[k] += weight * r[k];
+  estimate.eigenvalue = estimate.stiffness = estimate.damping = 0.0;
+  estimate.body = -1;
+  if (network.contacts.empty() || n == 0) return;
+  std::vector<double> g(6 * n);
+  for (int it = 0; it < iterations; ++it) {
+    // x <- x / |x|_M, and the share of each body.
+    double norm = 0.0, largest = -1.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double e = massNorm(network.bodies[i], part(x, i, 0), part(x, i, 1));
+      norm += e;
+      if (e > largest) {
+        largest = e;
+        estimate.body = static_cast<std::int32_t>(i);
+      }
+    }
+    if (!(norm > 0)) {  // the contacts' bodies had no component: restart
+      for (std::size_t k = 0; k < x.size(); ++k) x[k] = startValue(k);
+      continue;
+    }
+    const double scale = 1.0 / std::sqrt(norm);
+    for (double& v : x) v *= scale;
+    // g = K x, and the Rayleigh quotient x^T K x (x is M-normalised).
+    std::fill(g.begin(), g.end(), 0.0);
+    double stiffness = 0.0, damping = 0.0;
+    for (const NetworkContact& c : network.contacts) {
+      const auto a = static_cast<std::size_t>(c.a);
+      Vec3 du = -(part(x, a, 0) + part(x, a, 1).cross(c.lever_a));
+      if (c.b >= 0) {
+        const auto b = static_cast<std::size_t>(c.b);
+        du += part(x, b, 0) + part(x, b, 1).cross(c.lever_b);
+      }
+      const double un = du.dot(c.normal);
+      const Vec3 ut = du - un * c.normal;
+      stiffness += c.kn * un * un + c.ks * ut.squaredNorm();
+      damping += c.cn * un * un + c.cs * ut.squaredNorm();
+      const double wn = c.kn + damping_weight * c.cn, wt = c.ks + damping_weight * c.cs;
+      const Vec3 f = wn * un * c.normal + wt * ut;  // N per unit of x
+      addPart(g, a, 0, -f);
+      addPart(g, a, 1, -c.lever_a.cross(f));
+      if (c.b >= 0) {
+        const auto b = static_cast<std::size_t>(c.b);
+        addPart(g, b, 0, f);
+        addPart(g, b, 1, c.lever_b.cross(f));
+      }
+    }
+    estimate.stiffness = stiffness;
+    estimate.damping = damping;
+    estimate.eigenvalue = stiffness + damping_weight * damping;
+    // x <- M^-1 K x
+    for (std::size_t i = 0; i < n; ++i) {
+      const NetworkBody& b = network.bodies[i];
+      const Vec3 t = b.inv_mass * part(g, i, 0), r = b.inv_inertia * part(g, i, 1);
+      for (int k = 0; k < 3; ++k) {
+        x[6 * i + k] = t[k];
+        x[6 * i + 3 + k] = r[k];
+      }
+    }
+  }
+}
+
+}  // namespace rocklab::sim::detail
