@@ -174,6 +174,11 @@ int runCli(int argc, const char* const* argv) {
   study->add_option("--reference", reference, "finest (default: the last variant) or a lab value");
   study->add_option("--tolerance", tolerance, "error (%) the recommended variant may have (default 5)")
       ->check(CLI::PositiveNumber);
+  int seeds = 0;
+  study->add_option("--seeds", seeds,
+                    "runs per variant with seeds from the scene's up: mean, seed scatter and whether the errors "
+                    "exceed it (default: the study file's, else 1)")
+      ->check(CLI::PositiveNumber);
   addRunOptions(study);
   addSetOptions(study);
   std::string collect_dir;
@@ -246,6 +251,7 @@ int runCli(int argc, const char* const* argv) {
           throw std::invalid_argument("--reference '" + reference + "': give finest or a number (a lab value)");
       }
       if (tolerance > 0) so.tolerance_pct = tolerance;
+      if (seeds > 0) so.seeds = seeds;
       applySetOptions(so.runs);
       return runStudy(so, std::cerr);
     } catch (const std::exception& e) {

@@ -154,51 +154,133 @@ StudyAnalysis analyseStudy(std::vector<StudyPoint> points, std::optional<double>
 
 namespace {
 
+/// One row of the study: a variant with its seeds (o.seeds consecutive runs, the
+/// seed varying fastest) or a single run.
+struct Row {
+  StudyPoint point;
+  std::string status;
+  std::vector<std::size_t> members;  // indices into the runs
+};
+
+std::vector<Row> rowsOf(const StudyOptions& o, const std::vector<Variant>& done) {
+  const auto per = static_cast<std::size_t>(std::max(1, o.seeds));
+  std::vector<Row> rows;
+  for (std::size_t first = 0; first < done.size(); first += per) {
+    Row row;
+    StudyPoint& p = row.point;
+    p.values = done[first].values;
+    if (per > 1) p.values.pop_back();  // the seed
+    std::vector<double> figures;
+    double wall = 0.0;
+    std::string failure;
+    for (std::size_t k = first; k < std::min(done.size(), first + per); ++k) {
+      row.members.push_back(k);
+      const Variant& v = done[k];
+      const double f = number(lookup(v.results, o.figure));
+      if (v.code == kExitOk && std::isfinite(f)) {
+        figures.push_back(f);
+        wall += number(lookup(v.results, "wall_time_s.total"));
+      } else if (failure.empty()) {
+        failure = v.code != kExitOk ? v.status : "no figure";
+      }
+    }
+    p.runs = static_cast<int>(figures.size());
+    p.ok = !figures.empty() && failure.empty();
+    p.figure = figures.empty() ? kNaN : 0.0;
+    for (double f : figures) p.figure += f / static_cast<double>(figures.size());
+    p.wall_s = figures.empty() ? kNaN : wall / static_cast<double>(figures.size());  // per run
+    p.scatter = kNaN;
+    if (figures.size() > 1) {
+      double ss = 0.0;
+      for (double f : figures) ss += (f - p.figure) * (f - p.figure);
+      p.scatter = std::sqrt(ss / static_cast<double>(figures.size() - 1));
+    }
+    if (failure.empty()) row.status = "ok";
+    else if (per > 1) row.status = std::to_string(figures.size()) + " of " + std::to_string(row.members.size()) + " ok; " + failure;
+    else row.status = failure;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// |error| over the standard error of the difference to the reference: below ~2
+/// the variant cannot be told from the reference with these seeds.
+double errorOverScatter(const StudyPoint& p, const StudyPoint* ref) {
+  if (!ref || p.is_reference || !(p.runs > 1) || !(ref->runs > 1)) return kNaN;
+  const double se = std::sqrt(p.scatter * p.scatter / p.runs + ref->scatter * ref->scatter / ref->runs);
+  return se > 0 ? p.error / se : kNaN;
+}
+
 /// The study's table, study.json, plot and recommendation from what its runs left.
 int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const std::vector<PlannedRun>& runs,
                 const std::vector<Variant>& done, const std::string& name, std::ostream& log) {
+  const std::vector<Row> rows_in = rowsOf(o, done);
   std::vector<StudyPoint> points;
-  std::vector<std::string> status;
-  for (const Variant& v : done) {
-    StudyPoint p;
-    p.values = v.values;
-    p.figure = number(lookup(v.results, o.figure));
-    p.wall_s = number(lookup(v.results, "wall_time_s.total"));
-    p.ok = v.code == kExitOk && std::isfinite(p.figure);
-    points.push_back(p);
-    status.push_back(v.code != kExitOk ? v.status : p.ok ? "ok" : "no figure");
-  }
+  for (const Row& r : rows_in) points.push_back(r.point);
   const StudyAnalysis a = analyseStudy(points, o.reference, o.tolerance_pct);
+  const bool seeded = o.seeds > 1;
   const std::string reference_text =
       o.reference ? "the reference value " + fixed(a.reference, 6) : "the finest variant (" + fixed(a.reference, 6) + ")";
+  const StudyPoint* ref = nullptr;
+  for (const StudyPoint& p : a.points)
+    if (p.is_reference) ref = &p;
 
   std::vector<std::string> header;
-  for (const auto& [key, values] : o.runs.vary) header.push_back(key);
-  header.push_back(o.figure);
-  for (const char* h : {"error", "error_pct", "wall_time_s", "pareto", "reference", "status"}) header.push_back(h);
+  for (std::size_t k = 0; k + (seeded ? 1 : 0) < o.runs.vary.size(); ++k) header.push_back(o.runs.vary[k].first);
+  header.push_back(seeded ? o.figure + " (mean)" : o.figure);
+  if (seeded)
+    for (const char* h : {"scatter", "runs", "error_over_scatter"}) header.push_back(h);
+  for (const char* h : {"error", "error_pct", seeded ? "wall_time_s (per run)" : "wall_time_s", "pareto", "reference", "status"})
+    header.push_back(h);
   std::vector<std::vector<std::string>> rows;
   json rows_json = json::array();
+  bool all_within_scatter = seeded;
   for (std::size_t k = 0; k < a.points.size(); ++k) {
     const StudyPoint& p = a.points[k];
+    const double t = errorOverScatter(p, ref);
+    if (!p.is_reference) all_within_scatter = all_within_scatter && std::isfinite(t) && t < 2.0;
     std::vector<std::string> row = p.values;
-    for (const std::string& c : {fixed(p.figure, 8), fixed(p.error, 4), fixed(p.error_pct, 4), fixed(p.wall_s, 4),
-                                 std::string(p.pareto ? "yes" : ""), std::string(p.is_reference ? "yes" : ""), status[k]})
+    row.push_back(fixed(p.figure, 8));
+    if (seeded)
+      for (const std::string& c : {fixed(p.scatter, 4), std::to_string(p.runs), fixed(t, 3)}) row.push_back(c);
+    for (const std::string& c : {fixed(p.error, 4), fixed(p.error_pct, 4), fixed(p.wall_s, 4),
+                                 std::string(p.pareto ? "yes" : ""), std::string(p.is_reference ? "yes" : ""),
+                                 rows_in[k].status})
       row.push_back(c);
     rows.push_back(row);
     json values = json::object();
     for (std::size_t j = 0; j < p.values.size(); ++j) values[o.runs.vary[j].first] = p.values[j];
-    rows_json.push_back({{"values", values},
-                         {"folder", "runs/" + runs[k].name},
-                         {"figure", std::isfinite(p.figure) ? json(p.figure) : json(nullptr)},
-                         {"error", std::isfinite(p.error) ? json(p.error) : json(nullptr)},
-                         {"error_pct", std::isfinite(p.error_pct) ? json(p.error_pct) : json(nullptr)},
-                         {"wall_time_s", std::isfinite(p.wall_s) ? json(p.wall_s) : json(nullptr)},
-                         {"pareto", p.pareto},
-                         {"reference", p.is_reference},
-                         {"status", status[k]}});
+    auto num = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
+    json entry = {{"values", values},
+                  {"folder", "runs/" + runs[rows_in[k].members.front()].name},
+                  {"figure", num(p.figure)},
+                  {"error", num(p.error)},
+                  {"error_pct", num(p.error_pct)},
+                  {"wall_time_s", num(p.wall_s)},
+                  {"pareto", p.pareto},
+                  {"reference", p.is_reference},
+                  {"status", rows_in[k].status}};
+    if (seeded) {
+      json each = json::array();
+      for (std::size_t m : rows_in[k].members)
+        each.push_back({{"seed", done[m].values.back()},
+                        {"folder", "runs/" + runs[m].name},
+                        {"figure", num(number(lookup(done[m].results, o.figure)))},
+                        {"wall_time_s", num(number(lookup(done[m].results, "wall_time_s.total")))},
+                        {"status", done[m].code == kExitOk ? std::string("ok") : done[m].status}});
+      entry["runs"] = each;
+      entry["scatter"] = num(p.scatter);
+      entry["error_over_scatter"] = num(t);
+    }
+    rows_json.push_back(entry);
   }
   writeTable(header, rows, dir / "study.csv", log);
-  const std::string line = recommendation(o, a, reference_text);
+  std::string line = recommendation(o, a, reference_text);
+  if (seeded && ref) {
+    line += "; " + std::to_string(o.seeds) + " seeds a variant, the reference's seed scatter " +
+            fixed(ref->scatter, 4) + (a.reference != 0.0 ? " (" + fixed(100.0 * ref->scatter / std::abs(a.reference), 3) + " %)" : "");
+    if (all_within_scatter) line += "; every variant is within twice the standard error of the reference: the seeds cannot tell them apart";
+  }
   log << "recommendation: " << line << "\n";
   json out = {{"scene", name},
               {"description", o.description},
@@ -206,8 +288,9 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
               {"reference", {{"kind", o.reference ? "value" : "finest"},
                              {"value", std::isfinite(a.reference) ? json(a.reference) : json(nullptr)}}},
               {"tolerance_pct", o.tolerance_pct},
+              {"seeds", o.seeds},
               {"variants", rows_json},
-              {"recommended", a.recommended ? json("runs/" + runs[*a.recommended].name) : json(nullptr)},
+              {"recommended", a.recommended ? json("runs/" + runs[rows_in[*a.recommended].members.front()].name) : json(nullptr)},
               {"recommendation", line},
               {"complete", allOk(done)}};
   writeAtomically(dir / "study.json", out.dump(2) + "\n");
@@ -222,7 +305,8 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
 
 }  // namespace
 
-int runStudy(const StudyOptions& o, std::ostream& log) {
+int runStudy(const StudyOptions& options, std::ostream& log) {
+  StudyOptions o = options;
   if (o.runs.vary.empty()) {
     log << "error: study: give at least one --vary key=a,b,c (from the cheapest to the finest value)\n";
     return kExitBadInput;
@@ -230,6 +314,23 @@ int runStudy(const StudyOptions& o, std::ostream& log) {
   if (o.figure.empty()) {
     log << "error: study: give --figure, a results.json path such as restitution or tracking.rms_error_pct\n";
     return kExitBadInput;
+  }
+  if (o.seeds > 1) {
+    // Seeds as the innermost (fastest) dimension, from the scene's own seed up.
+    for (const auto& [key, values] : o.runs.vary)
+      if (key == "scene.seed") {
+        log << "error: study: --seeds repeats every variant with its own seeds; do not also --vary scene.seed\n";
+        return kExitBadInput;
+      }
+    std::uint64_t base = 1;
+    try {
+      base = sceneFor(o.runs, expandVariants(o.runs).front().values).run.seed;
+    } catch (const SceneError&) {
+      // reported with the runs below
+    }
+    std::vector<std::string> seeds;
+    for (int k = 0; k < o.seeds; ++k) seeds.push_back(std::to_string(base + static_cast<std::uint64_t>(k)));
+    o.runs.vary.emplace_back("scene.seed", seeds);
   }
   // Validated before anything runs: an invalid variant is listed as failed (exit
   // 2) and costs nothing; when none is valid, nothing is written.
@@ -245,6 +346,7 @@ int runStudy(const StudyOptions& o, std::ostream& log) {
                {"figure", o.figure},
                {"reference", o.reference ? json(*o.reference) : json("finest")},
                {"tolerance_pct", o.tolerance_pct},
+               {"seeds", o.seeds},
                {"description", o.description}};
   writePlanFiles(dir, o.runs, runs, what);
   log << "study of " << first.run.name << ": " << o.figure << " for " << runs.size() << " variants into "
@@ -270,6 +372,7 @@ int collectStudy(const std::filesystem::path& dir, const SweepOptions& runs_opti
   if (plan.contains("reference") && plan["reference"].is_number()) o.reference = plan["reference"].get<double>();
   o.tolerance_pct = plan.value("tolerance_pct", o.tolerance_pct);
   o.description = plan.value("description", "");
+  o.seeds = plan.value("seeds", 1);
   return reportStudy(dir, o, runs, done, std::filesystem::path(o.runs.scene).stem().string(), log);
 }
 
@@ -315,6 +418,7 @@ StudyOptions loadStudyFile(const std::filesystem::path& file) {
     t->string("reference", "finest", {"finest"});
   }
   o.tolerance_pct = t->number("tolerance_pct", o.tolerance_pct, Range::positive());
+  o.seeds = static_cast<int>(t->integer("seeds", 1, Range::closed(1, 1000)));
   o.runs.overrides = t->stringList("set");
   for (TableReader& v : t->tableArray("vary")) {
     const std::string key = v.requiredString("key");

@@ -73,7 +73,7 @@ std::string TimestepAudit::describe(const TimestepSettings& settings) const {
     s << "  damped stability limit (dashpots)    " << damped_limit << " s\n";
   if (automatic < settings.safety_factor * critical)
     s << "  automatic = " << kDampedMargin << " x damped limit        " << automatic << " s (below "
-      << settings.safety_factor << " x critical: strong dashpots)\n";
+      << settings.safety_factor << " x critical: capped by the dashpots)\n";
   else
     s << "  automatic = " << settings.safety_factor << " x critical        " << automatic << " s\n";
   s << "  chosen dt                            " << chosen << " s  (dt/dt_crit = " << ratio()

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_support.h"
 
 namespace fs = std::filesystem;
@@ -137,4 +139,40 @@ TEST_CASE("the Slurm array script on a local one-node Slurm gives the table of -
   CHECK(slurm_logs == 3);
   fs::remove_all(planned);
   fs::remove_all(jobs);
+}
+
+TEST_CASE("study --seeds: each variant runs once per seed and the table gives mean, scatter and error over scatter", "[plan]") {
+  const fs::path dir = fresh("seeds");
+  REQUIRE(cli({"study", "drop", "--vary", "timestep.safety_factor=0.4,0.2", "--figure", "restitution", "--seeds", "3",
+               "--plan", dir.string()}) == 0);
+  const auto run_lines = lines(dir / "runs.txt");
+  REQUIRE(run_lines.size() == 6);  // 2 variants x 3 seeds, the seed fastest, from the scene's seed (1) up
+  for (int k = 0; k < 6; ++k) CHECK(run_lines[k].find("scene.seed=" + std::to_string(1 + k % 3) + "'") != std::string::npos);
+  CHECK(cli({"study", "drop", "--vary", "scene.seed=1,2", "--figure", "restitution", "--seeds", "2", "--plan",
+             (dir / "both").string()}) == 2);
+  // Stand-ins for six finished runs (the figures chosen so that the statistics are known):
+  // variant 0.4: 0.70, 0.72, 0.74 (mean 0.72, sample sd 0.02); 0.2: 0.70, 0.70, 0.73 (0.71, sd 0.01732).
+  const double figures[] = {0.70, 0.72, 0.74, 0.70, 0.70, 0.73};
+  int k = 0;
+  for (const char* sf : {"0.4", "0.2"})
+    for (int seed = 1; seed <= 3; ++seed) {
+      const fs::path run = dir / "runs" / ("timestep.safety_factor=" + std::string(sf) + "__scene.seed=" + std::to_string(seed));
+      fs::create_directories(run);
+      std::ofstream(run / "results.json") << "{\"status\": \"completed\", \"restitution\": " << figures[k++]
+                                          << ", \"wall_time_s\": {\"total\": " << (sf[2] == '4' ? 1.0 : 2.0) << "}}";
+    }
+  REQUIRE(cli({"collect", dir.string()}) == 0);
+  const auto table = lines(dir / "study.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[0] == "timestep.safety_factor,restitution (mean),scatter,runs,error_over_scatter,error,error_pct,"
+                    "wall_time_s (per run),pareto,reference,status");
+  // 0.01 / sqrt(0.02^2/3 + 0.01732^2/3) = 0.6547
+  CHECK(table[1].rfind("0.4,0.72,0.02,3,0.655,0.01,1.408,1,yes,,ok", 0) == 0);
+  CHECK(table[2].rfind("0.2,0.71,0.01732,3,,0,0,2,", 0) == 0);
+  std::ifstream in(dir / "study.json");
+  const auto study = nlohmann::json::parse(in);
+  CHECK(study["seeds"] == 3);
+  CHECK(study["variants"][0]["runs"].size() == 3);
+  CHECK(study["recommendation"].get<std::string>().find("the seeds cannot tell them apart") != std::string::npos);
+  fs::remove_all(dir);
 }

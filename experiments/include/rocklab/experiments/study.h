@@ -23,18 +23,25 @@ struct StudyOptions {
   double tolerance_pct = 5.0;       // the recommendation: cheapest variant from which on every
                                     // variant listed after it is within this error
   std::string description;          // from a study file, for the log and study.json
+  int seeds = 1;                    // runs per variant, with scene.seed = the scene's seed, +1, ...:
+                                    // the figure is their mean, and its scatter is reported (a chute or
+                                    // heap varies by 1-5 % from one packing to the next)
 };
 
 /// One variant's row.
 struct StudyPoint {
   std::vector<std::string> values;  // one per varied key
-  double figure = 0.0;              // NaN when the run did not report it
+  double figure = 0.0;              // NaN when the run did not report it; with seeds: their mean
   double error = 0.0;               // |figure - reference|, the figure's unit
   double error_pct = 0.0;           // 100 |figure - reference| / |reference| (NaN if reference is 0)
   double wall_s = 0.0;              // wall time of the run (results.json wall_time_s.total)
   bool ok = true;                   // the run ended normally and reported the figure
   bool is_reference = false;        // the finest variant, when it is the reference
   bool pareto = false;              // no other ok variant is both cheaper and closer
+  // With several seeds: the runs that reported the figure, and its sample
+  // standard deviation over them (NaN with fewer than two).
+  int runs = 1;
+  double scatter = 0.0;
 };
 
 struct StudyAnalysis {
