@@ -601,6 +601,8 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
         t->integer("check_interval", model.watchdog.check_interval, Range::closed(1, 1e9)));
     model.watchdog.network_iterations = static_cast<int>(
         t->integer("network_iterations", model.watchdog.network_iterations, Range::closed(0, 1000)));
+    model.watchdog.network_interval = static_cast<int>(
+        t->integer("network_interval", model.watchdog.network_interval, Range::closed(1, 1e9)));
     t->finish();
   }
   if (auto t = root.table("relaxation")) {

@@ -59,7 +59,8 @@ void iterateSpectrum(const ContactNetwork& network, double damping_weight, int i
   // appeared since, and power iteration alone would never find it.
   const std::uint64_t offset = 6 * n * (estimate.calls++ + 1);
   double fresh = 0.0;
-  std::vector<double> r(6 * n);
+  std::vector<double>& r = estimate.fresh;
+  r.resize(6 * n);
   for (std::size_t k = 0; k < r.size(); ++k) r[k] = startValue(offset + k);
   for (std::size_t i = 0; i < n; ++i) fresh += massNorm(network.bodies[i], part(r, i, 0), part(r, i, 1));
   const double weight = (x.empty() || std::all_of(x.begin(), x.end(), [](double v) { return v == 0.0; }) ? 1.0 : 0.01) /
@@ -68,7 +69,8 @@ void iterateSpectrum(const ContactNetwork& network, double damping_weight, int i
   estimate.eigenvalue = estimate.stiffness = estimate.damping = 0.0;
   estimate.body = -1;
   if (network.contacts.empty() || n == 0) return;
-  std::vector<double> g(6 * n);
+  std::vector<double>& g = estimate.scratch;
+  g.resize(6 * n);
   for (int it = 0; it < iterations; ++it) {
     // x <- x / |x|_M, and the share of each body.
     double norm = 0.0, largest = -1.0;

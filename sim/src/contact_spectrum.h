@@ -69,6 +69,7 @@ struct SpectrumEstimate {
   double damping = 0.0;     // 1/s, its C part
   std::int32_t body = -1;   // body with the largest share of the mode's energy
   std::uint64_t calls = 0;  // iterateSpectrum calls so far (picks each call's fresh vector)
+  std::vector<double> scratch, fresh;  // buffers reused between calls
 };
 
 /// Runs `iterations` power iterations on M^-1 (K + damping_weight C) from

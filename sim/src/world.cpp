@@ -115,6 +115,7 @@ struct World::Impl {
   std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
   // Highest frequency of the contact network (step check), kept between checks.
   detail::SpectrumEstimate spectrum;
+  detail::ContactNetwork network;  // rebuilt at every check (buffers reused)
 
   // Below this many balls per thread a second thread does not pay: a step of a
   // few thousand balls takes tens of microseconds, and waking the team, the
@@ -144,7 +145,7 @@ struct World::Impl {
   void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
   void checkEnergy(const Energy& e);
-  template <class Law> detail::ContactNetwork contactNetwork() const;
+  template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
   void checkNetworkStep();
   void startRelaxation();
   void updateRelaxation();
@@ -958,8 +959,9 @@ void World::Impl::checkEnergy(const Energy& e) {
 // The touching contacts as springs between rigid bodies (free balls and clumps),
 // for the step check. A shear spring counts only while it sticks.
 template <class Law>
-detail::ContactNetwork World::Impl::contactNetwork() const {
-  detail::ContactNetwork net;
+void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
+  net.bodies.clear();  // capacity kept between checks
+  net.contacts.clear();
   const std::size_t n = p.size();
   const ClumpState& k = p.clumps;
   std::vector<std::int32_t> body_of(n);
@@ -1032,14 +1034,15 @@ detail::ContactNetwork World::Impl::contactNetwork() const {
       add(i, -1, wc.normal, cp, cp, overlap, ri, p.mass[i], props, wall_shear[w]);
     }
   }
-  return net;
 }
 
 void World::Impl::checkNetworkStep() {
   if (model.watchdog.network_iterations <= 0) return;
-  const detail::ContactNetwork net = model.contact.law == ContactLaw::Linear
-                                         ? contactNetwork<detail::LinearLaw>()
-                                         : contactNetwork<detail::HertzMindlinLaw>();
+  detail::ContactNetwork& net = network;
+  if (model.contact.law == ContactLaw::Linear)
+    buildContactNetwork<detail::LinearLaw>(net);
+  else
+    buildContactNetwork<detail::HertzMindlinLaw>(net);
   detail::iterateSpectrum(net, 2.0 / dt, model.watchdog.network_iterations, spectrum);
   // Stable while L < 4 / dt^2 (contact_spectrum.h): the ratio dt / (2 / sqrt(L)).
   const double ratio = 0.5 * dt * std::sqrt(spectrum.eigenvalue);
@@ -1072,7 +1075,11 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   const double h = half_kick_pending ? 0.5 * dt : dt;
   const int interval = std::max(1, model.watchdog.check_interval);
   const bool energy_due = (step % static_cast<std::uint64_t>(interval)) == 0 && energyCheckApplies();
-  const bool observe = observer || energy_due;
+  int network_every = std::max(1, model.watchdog.network_interval);
+  if (dt > audit.automatic * (1.0 + 1e-12)) network_every = std::min(network_every, interval);  // a forced step
+  const bool network_due =
+      model.watchdog.network_iterations > 0 && step % static_cast<std::uint64_t>(network_every) == 0;
+  const bool observe = observer || energy_due || network_due;
   StepChecks merged;
   // 3 + 4 (+ 6 unless observed): contacts, gather, integrate.
   if (model.contact.law == ContactLaw::Linear)
@@ -1117,7 +1124,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     // observer may end the run (a drop test ends at the rebound) before the next
     // scheduled check would see a blow-up.
     if (energyCheckApplies()) checkEnergy(s.energy);
-    if (energy_due) checkNetworkStep();
+    if (network_due) checkNetworkStep();
     if (observer) {
       std::vector<Vec3> total(n);  // total force including gravity
       for (std::size_t i = 0; i < n; ++i) total[i] = acc_force[i] + gravity * (isMember(i) ? 0.0 : p.mass[i]);
