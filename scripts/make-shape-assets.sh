@@ -22,3 +22,9 @@ for seed in 1 2 3; do
   echo "pebble-$seed: keys for the scene (mass, principal_inertia at 2730 kg/m^3):"
   grep -E "^(mass|principal_inertia)" "$tmp/chute$seed/clump.toml"
 done
+# The clump-resolution study (assets/studies/chute-clump-resolution.toml): pebble-1 as
+# 1 and 4 spheres beside its 16-sphere clump above.
+for n in 1 4; do
+  "$rocklab" shape assets/meshes/pebble-1.stl --unit mm --size 0.0199 --spheres $n --no-preview --out "$tmp/res$n"
+  cp "$tmp/res$n/clump.txt" assets/clumps/pebble-1-s$n.txt
+done
