@@ -27,6 +27,7 @@
 // iteration approaches L from below: an estimate above the limit is a mode that
 // really is unstable (no false alarm).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "rocklab/geometry/vec.h"
@@ -57,6 +58,7 @@ struct NetworkContact {
 
 struct ContactNetwork {
   std::vector<NetworkBody> bodies;
+  std::vector<std::string> body_names;  // "particle 12", "clump 3": for messages
   std::vector<NetworkContact> contacts;
 };
 

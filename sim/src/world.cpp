@@ -961,6 +961,7 @@ void World::Impl::checkEnergy(const Energy& e) {
 template <class Law>
 void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
   net.bodies.clear();  // capacity kept between checks
+  net.body_names.clear();
   net.contacts.clear();
   const std::size_t n = p.size();
   const ClumpState& k = p.clumps;
@@ -971,12 +972,14 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
     const double inertia = 1.0 / p.inv_inertia[i];
     net.bodies.push_back({p.inv_mass[i], inertia * geometry::Mat3::Identity(),
                           p.inv_inertia[i] * geometry::Mat3::Identity()});
+    net.body_names.push_back("particle " + std::to_string(p.id[i]));
   }
   const auto first_clump = static_cast<std::int32_t>(net.bodies.size());
   for (std::size_t c = 0; c < k.size(); ++c) {
     const geometry::Mat3 r = k.orientation[c].toRotationMatrix();
     net.bodies.push_back({1.0 / k.mass[c], r * k.inertia[c].asDiagonal() * r.transpose(),
                           r * k.inertia[c].cwiseInverse().asDiagonal() * r.transpose()});
+    net.body_names.push_back("clump " + std::to_string(k.id[c]));
   }
   if (has_clumps)
     for (std::size_t i = 0; i < n; ++i)
@@ -1053,8 +1056,9 @@ void World::Impl::checkNetworkStep() {
   const double stable = detail::stableStep(spectrum.stiffness, spectrum.damping);
   std::ostringstream s;
   s << "watchdog: at t = " << fmtNum(time) << " s (step " << step << ") the step is unstable for the contact "
-    << "network: its fastest mode (" << net.contacts.size() << " touching contacts; largest share on body "
-    << spectrum.body << ") has omega = " << fmtNum(omega) << " rad/s and dashpots " << fmtNum(spectrum.damping)
+    << "network: its fastest mode (" << net.contacts.size() << " touching contacts; largest share on "
+    << (spectrum.body >= 0 ? net.body_names[static_cast<std::size_t>(spectrum.body)] : std::string("none"))
+    << ") has omega = " << fmtNum(omega) << " rad/s and dashpots " << fmtNum(spectrum.damping)
     << " 1/s, stable only for dt < " << fmtNum(stable) << " s (" << fmtNum(stable / audit.critical)
     << " x critical). Sticking contacts would creep and slip without a blow-up, unseen by the energy check. "
        "The critical step counts one contact per body; a body pressed by several, a stuck shear spring that "

@@ -44,6 +44,10 @@ TEST_CASE("a short run writes run.h5 - checkpoint - vtk and results.json", "[cli
   CHECK(r["particles"] == 200);
   CHECK(r["outputs"]["frames"] == 3);  // t = 0, 0.001 and the last step
   CHECK(r["wall_time_s"]["stepping"].get<double>() > 0);
+  // The time-step report: the damped limit and the contact-network checks (every 1000 steps).
+  CHECK(r["timestep"]["damped_limit_s"].get<double>() > r["timestep"]["automatic_s"].get<double>());
+  CHECK(r["timestep"]["network_checks"].get<int>() == (r["steps"].get<int>() + 999) / 1000);
+  CHECK(r["timestep"]["network_step_ratio_max"].get<double>() < 1.0);
 
   // Restart from the checkpoint continues to a later end time.
   const fs::path out2 = tempDir("restart");
