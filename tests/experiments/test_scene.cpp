@@ -233,3 +233,16 @@ TEST_CASE("contact.stiffness_scale scales every material's stiffness - and space
   CHECK(s.model.materials[0].ks == Approx(1e5));
   CHECK_THAT(errorOf(kMinimal, {"contact.stiffness_scale=0"}), Contains("stiffness_scale") && Contains("> 0"));
 }
+
+TEST_CASE("watchdog network keys and relaxation.steps are read and range-checked", "[scene]") {
+  const Scene s = loadSceneText(kMinimal, "t.toml",
+                                {"relaxation.steps=5000", "watchdog.network_iterations=0", "watchdog.network_interval=250"});
+  CHECK(s.model.relaxation.steps == 5000);
+  CHECK(s.model.watchdog.network_iterations == 0);
+  CHECK(s.model.watchdog.network_interval == 250);
+  const Scene d = loadSceneText(kMinimal, "t.toml", {});
+  CHECK(d.model.relaxation.steps == 0);  // off unless asked
+  CHECK(d.model.watchdog.network_iterations > 0);
+  CHECK_THAT(errorOf(kMinimal, {"relaxation.steps=-1"}), Contains("relaxation.steps"));
+  CHECK_THAT(errorOf(kMinimal, {"watchdog.network_interval=0"}), Contains("network_interval"));
+}
