@@ -267,7 +267,7 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
                         {"folder", "runs/" + runs[m].name},
                         {"figure", num(number(lookup(done[m].results, o.figure)))},
                         {"wall_time_s", num(number(lookup(done[m].results, "wall_time_s.total")))},
-                        {"status", done[m].code == kExitOk ? std::string("ok") : done[m].status}});
+                        {"status", done[m].status}});  // inspectRuns: "ok", "exit N: ...", "missing"
       entry["runs"] = each;
       entry["scatter"] = num(p.scatter);
       entry["error_over_scatter"] = num(t);

@@ -23,6 +23,14 @@ PairProps ballBallProps(const Material& a, const Material& b);
 /// Mirror rule for Hertz (ref §4.2): the ball's own G and nu; series springs for linear.
 PairProps ballWallProps(const Material& ball, const Material& wall);
 
+/// Mass of a ball–ball dashpot (Eq 2-18); a ball–wall dashpot uses the ball's mass.
+inline double dampingMass(DampingMass kind, double ma, double mb) {
+  return kind == DampingMass::Average ? 0.5 * (ma + mb) : ma * mb / (ma + mb);
+}
+
+/// Dashpot of damping ratio `beta` on a spring k and a mass m (Eq 2-16, 2-17).
+inline double dashpot(double beta, double mass, double k) { return 2.0 * beta * std::sqrt(mass * k); }
+
 /// Input of one contact evaluation.
 struct ContactGeometry {
   Vec3 normal;        // unit, from the body the force acts on (A) towards the other (B)
@@ -73,7 +81,7 @@ template <class Law>
   const Vec3 vt = g.rel_velocity - vn * n;
   // Normal dashpot, Eq 2-16..2-18 with the tangent stiffness; may pull (recorded choice).
   const double cn =
-      cm.damping_normal > 0 ? 2.0 * cm.damping_normal * std::sqrt(g.damping_mass * kn_tangent) : 0.0;
+      cm.damping_normal > 0 ? dashpot(cm.damping_normal, g.damping_mass, kn_tangent) : 0.0;
   const double fn_total = fn_elastic - cn * vn;
 
   // Shear spring: rotate the stored force into the current tangent plane keeping
@@ -102,7 +110,7 @@ template <class Law>
     ft = shear;
   } else {
     ft = shear;
-    if (cm.damping_shear > 0) ft += (2.0 * cm.damping_shear * std::sqrt(g.damping_mass * ks)) * vt;
+    if (cm.damping_shear > 0) ft += dashpot(cm.damping_shear, g.damping_mass, ks) * vt;
   }
   return {ft - fn_total * n, fn_elastic};
 }

@@ -124,13 +124,13 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
   auto dampedModes = [&](double kn, double ks, const Body& self, const Body* b) {
     const double inv_n = self.inv_n + (b ? b->inv_n : 0.0), inv_t = self.inv_t + (b ? b->inv_t : 0.0);
     double md = self.m;  // ball–wall: the ball's mass (Eq 2-18)
-    if (b) md = cm.damping_mass == DampingMass::Average ? 0.5 * (self.m + b->m) : self.m * b->m / (self.m + b->m);
+    if (b) md = detail::dampingMass(cm.damping_mass, self.m, b->m);
     if (kn > 0) {
-      const double c = 2.0 * cm.damping_normal * std::sqrt(md * kn);
+      const double c = detail::dashpot(cm.damping_normal, md, kn);
       damped_limit = std::min(damped_limit, dampedStabilityLimit(kn, kDashpotMultiplicity * c, inv_n));
     }
     if (ks > 0) {
-      const double c = 2.0 * cm.damping_shear * std::sqrt(md * ks);
+      const double c = detail::dashpot(cm.damping_shear, md, ks);
       damped_limit = std::min(damped_limit, dampedStabilityLimit(ks, kDashpotMultiplicity * c, inv_t));
     }
   };

@@ -549,7 +549,7 @@ template <class Law>
   g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
   g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
   const double mi = p.mass[i], mj = p.mass[j];
-  g.damping_mass = model.contact.damping_mass == DampingMass::Average ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
+  g.damping_mass = detail::dampingMass(model.contact.damping_mass, mi, mj);
   const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
   const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, pair_shear[k]);
   fi = res.force;
@@ -1002,8 +1002,8 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
     c.kn = tangent;
     c.ks = sticks ? Law::shear(props, fn, r_tilde) : 0.0;
     // The dashpots of evaluateContact (Eq 2-16..2-18); the shear one only while sticking.
-    c.cn = 2.0 * cm.damping_normal * std::sqrt(damping_mass * c.kn);
-    c.cs = 2.0 * cm.damping_shear * std::sqrt(damping_mass * c.ks);
+    c.cn = detail::dashpot(cm.damping_normal, damping_mass, c.kn);
+    c.cs = detail::dashpot(cm.damping_shear, damping_mass, c.ks);
     net.contacts.push_back(c);
   };
   for (std::size_t i = 0; i < n; ++i) {
@@ -1020,8 +1020,7 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
       if (relaxing()) overlap -= relax_factor * pair_relax[q];
       if (overlap <= 0) continue;
       const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
-      const double mi = p.mass[i], mj = p.mass[j];
-      const double md = cm.damping_mass == DampingMass::Average ? 0.5 * (mi + mj) : mi * mj / (mi + mj);
+      const double md = detail::dampingMass(cm.damping_mass, p.mass[i], p.mass[j]);
       add(i, body_of[j], normal, cp, centre(j), overlap, 2.0 * ri * rj / (ri + rj), md, props, pair_shear[q]);
     }
     for (std::uint32_t w = wall_offset[i]; w < wall_offset[i + 1]; ++w) {
