@@ -27,6 +27,7 @@
 #include "camera_recorder.h"
 #include "marker_tracking.h"
 #include "plot.h"
+#include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
 
 namespace rocklab::experiments {
@@ -136,7 +137,7 @@ class ChuteExperiment final : public Experiment {
       const sim::Wall& top = world->model().walls[wallIndex(world->model(), e_.top_wall)];
       Vec3 normal = top.normal, point = top.point;
       if (top.shape == sim::WallShape::Polygon) {
-        normal = (top.vertices[1] - top.vertices[0]).cross(top.vertices[2] - top.vertices[0]).normalized();
+        normal = sim::polygonNormal(top.vertices);
         point = top.vertices[0];
       }
       if (normal.z() > 0) normal = -normal;  // faces down, into the channel

@@ -1,20 +1,10 @@
 #include "frame_builder.h"
 
-#include <cmath>
-#include <numbers>
+#include "rocklab/sim/wall_motion.h"
 
 namespace rocklab::experiments {
 
 using geometry::Vec3;
-
-geometry::Vec3 wallPointAt(const sim::WallMotion& m, const Vec3& x0, double t) {
-  // x(t) = pivot + T(t) + R(t) (x0 - pivot), as in sim/src/wall_runtime.h.
-  const Vec3 translation = m.velocity * t + m.amplitude * std::sin(2.0 * std::numbers::pi * m.frequency * t);
-  const double angle = m.angular_velocity.norm() * t;
-  const Vec3 arm = x0 - m.pivot;
-  const Vec3 turned = angle > 0 ? Vec3(Eigen::AngleAxisd(angle, m.angular_velocity.normalized()) * arm) : arm;
-  return m.pivot + translation + turned;
-}
 
 FrameBuilder::FrameBuilder(const Scene& scene)
     : looks_(scene.wall_looks), material_colours_(scene.material_colours) {
@@ -54,24 +44,24 @@ render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const si
       mesh.colour = look.colour;
       mesh.opacity = look.opacity;
       // Rigid motion: rotation about the pivot plus translation (the renderer takes R x + t).
-      const Vec3 origin = wallPointAt(w.motion, Vec3::Zero(), s.time);
-      const double angle = w.motion.angular_velocity.norm() * s.time;
-      if (angle > 0) mesh.rotation = Eigen::AngleAxisd(angle, w.motion.angular_velocity.normalized()).toRotationMatrix();
-      mesh.translation = origin;
+      const sim::WallPose pose = sim::wallPoseAt(w.motion, s.time);
+      mesh.rotation = pose.rotation;
+      mesh.translation = pose.place(Vec3::Zero());
       f.meshes.push_back(mesh);
       continue;
     }
     render::Polygon poly;
     poly.colour = look.colour;
     poly.opacity = look.opacity;
+    const sim::WallPose pose = sim::wallPoseAt(w.motion, s.time);
     if (w.shape == sim::WallShape::Polygon) {
-      for (const Vec3& v : w.vertices) poly.vertices.push_back(wallPointAt(w.motion, v, s.time));
+      for (const Vec3& v : w.vertices) poly.vertices.push_back(pose.place(v));
     } else {
       // An infinite plane drawn as a square of plane_size around its point.
       const Vec3 n = w.normal.normalized();
       const Vec3 a = n.unitOrthogonal(), b = n.cross(a);
       const double h = 0.5 * look.plane_size;
-      const Vec3 c = wallPointAt(w.motion, w.point, s.time);
+      const Vec3 c = pose.place(w.point);
       poly.vertices = {c - h * a - h * b, c + h * a - h * b, c + h * a + h * b, c - h * a + h * b};
     }
     f.polygons.push_back(poly);

@@ -28,7 +28,4 @@ class FrameBuilder {
   std::vector<std::shared_ptr<const geometry::TriangleMesh>> meshes_;  // per wall (mesh walls only)
 };
 
-/// Position at time t of a wall point x0 under its prescribed motion (model.h).
-geometry::Vec3 wallPointAt(const sim::WallMotion& m, const geometry::Vec3& x0, double t);
-
 }  // namespace rocklab::experiments

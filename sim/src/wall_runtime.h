@@ -9,6 +9,7 @@
 
 #include "rocklab/geometry/closest_point.h"
 #include "rocklab/sim/model.h"
+#include "rocklab/sim/wall_motion.h"
 
 namespace rocklab::sim::detail {
 
@@ -28,7 +29,7 @@ class WallRuntime {
     if (w.shape == WallShape::Plane) {
       unit_normal_ = w.normal.normalized();
     } else if (w.shape == WallShape::Polygon) {
-      unit_normal_ = (w.vertices[1] - w.vertices[0]).cross(w.vertices[2] - w.vertices[0]).normalized();
+      unit_normal_ = polygonNormal(w.vertices);
       for (const Vec3& v : w.vertices) extent_ = std::max(extent_, (v - w.motion.pivot).norm());
     } else {
       unit_normal_ = Vec3::UnitZ();
@@ -40,16 +41,14 @@ class WallRuntime {
   void update(const Wall& w, double t) {
     active = w.activeAt(t);
     if (is_static_) return;
-    const WallMotion& m = w.motion;
-    const double phase = 2.0 * std::numbers::pi * m.frequency;
-    translation_ = m.velocity * t + m.amplitude * std::sin(phase * t);
-    velocity_ = m.velocity + m.amplitude * (phase * std::cos(phase * t));
-    omega_ = m.angular_velocity;
-    angle_ = omega_.norm() * t;
-    rotation_ = angle_ > 0 ? Eigen::AngleAxisd(angle_, omega_.normalized()).toRotationMatrix()
-                           : geometry::Mat3::Identity();
-    centre_ = m.pivot + translation_;
-    pivot_ = m.pivot;
+    const WallPose pose = wallPoseAt(w.motion, t);
+    translation_ = pose.translation;
+    velocity_ = pose.velocity;
+    omega_ = pose.omega;
+    angle_ = pose.angle;
+    rotation_ = pose.rotation;
+    centre_ = pose.pivot + translation_;
+    pivot_ = pose.pivot;
   }
 
   void setReference() {

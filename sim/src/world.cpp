@@ -12,6 +12,7 @@
 #include "contact_spectrum.h"
 #include "neighbor_list.h"
 #include "rigid_body.h"
+#include "rocklab/sim/wall_motion.h"
 #include "wall_runtime.h"
 
 namespace rocklab::sim {
@@ -184,11 +185,11 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
     }
     if (w.shape == WallShape::Polygon) {
       if (w.vertices.size() < 3) return where + ": a polygon needs at least 3 vertices";
-      const Vec3 nrm = (w.vertices[1] - w.vertices[0]).cross(w.vertices[2] - w.vertices[0]);
+      const Vec3 nrm = polygonNormal(w.vertices);
       if (!(nrm.norm() > 0)) return where + ": the first three vertices are collinear";
       const double scale = (w.vertices[1] - w.vertices[0]).norm();
       for (const Vec3& v : w.vertices)
-        if (std::abs((v - w.vertices[0]).dot(nrm.normalized())) > 1e-9 * std::max(1.0, scale))
+        if (std::abs((v - w.vertices[0]).dot(nrm)) > 1e-9 * std::max(1.0, scale))
           return where + ": the vertices are not in one plane";
     }
     if (w.shape == WallShape::Mesh) {

@@ -1,0 +1,47 @@
+#pragma once
+// Prescribed wall motion (model.h WallMotion) evaluated at a time: the one
+// formula that the engine (src/wall_runtime.h) and the frame builder (what the
+// cameras draw) share, so a drawn wall is where the balls feel it.
+//
+//   x(t) = pivot + T(t) + R(t) (x0 - pivot),   T(t) = v t + A sin(2 pi f t),
+//   R(t) = rotation by |omega| t about omega  (x0: a point of the wall at rest)
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "rocklab/sim/model.h"
+
+namespace rocklab::sim {
+
+struct WallPose {
+  geometry::Vec3 translation = geometry::Vec3::Zero();  // m, T(t)
+  geometry::Vec3 velocity = geometry::Vec3::Zero();     // m/s, dT/dt
+  geometry::Vec3 omega = geometry::Vec3::Zero();        // rad/s
+  geometry::Vec3 pivot = geometry::Vec3::Zero();        // m, at rest
+  double angle = 0.0;                                   // rad turned since t = 0
+  geometry::Mat3 rotation = geometry::Mat3::Identity(); // R(t)
+
+  /// Where the rest point x0 of the wall is at this pose.
+  geometry::Vec3 place(const geometry::Vec3& x0) const { return pivot + translation + rotation * (x0 - pivot); }
+};
+
+inline WallPose wallPoseAt(const WallMotion& m, double t) {
+  WallPose p;
+  const double phase = 2.0 * std::numbers::pi * m.frequency;
+  p.translation = m.velocity * t + m.amplitude * std::sin(phase * t);
+  p.velocity = m.velocity + m.amplitude * (phase * std::cos(phase * t));
+  p.omega = m.angular_velocity;
+  p.pivot = m.pivot;
+  p.angle = p.omega.norm() * t;
+  p.rotation = p.angle > 0 ? geometry::Mat3(Eigen::AngleAxisd(p.angle, p.omega.normalized()).toRotationMatrix())
+                           : geometry::Mat3::Identity();
+  return p;
+}
+
+/// Unit normal of a planar polygon, right-handed over its first three vertices
+/// (zero when they are collinear; validateModel refuses such a wall).
+inline geometry::Vec3 polygonNormal(const std::vector<geometry::Vec3>& v) {
+  return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+}
+
+}  // namespace rocklab::sim
