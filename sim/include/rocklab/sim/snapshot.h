@@ -16,8 +16,9 @@ struct Energy {
   double kinetic_rotational = 0.0;     // J
   double potential_gravity = 0.0;      // J, -sum m g.x (datum at the origin)
   double elastic = 0.0;                // J, stored in normal and shear contact springs
+  double potential_other = 0.0;        // J, stored by force contributions (force_contribution.h)
   double total() const {
-    return kinetic_translational + kinetic_rotational + potential_gravity + elastic;
+    return kinetic_translational + kinetic_rotational + potential_gravity + elastic + potential_other;
   }
 };
 

@@ -1,22 +1,28 @@
 #pragma once
-// World = constant Model + mutable state. One call of step() advances one time
-// step through named stages:
+// World = constant Model + mutable state. One call of step() runs the stages
+// below in this order (World::Impl::doStep in src/world.cpp, one call each; each
+// stage's body is in a file of its own in src/stages/, and its wall time is in
+// WorldStats::stage_seconds):
 //
-//   1. prepare      gravity schedule, wall poses and activity at t   (reads time)
-//   2. neighbours   rebuild the pair and wall-candidate lists when some body
-//                   moved more than half the skin; history carried over
-//   3. contacts     force–displacement law at every pair and wall contact
-//                   (reads x, v, omega at t - dt/2; writes pair slots, shear history)
-//   4. gather       sum each ball's contact forces in a fixed order (bitwise
-//                   identical for any thread count)
-//   5. observe      only on steps an observer asked for: synchronised snapshot
-//   6. integrate    leapfrog kick and drift (Eq 2-11..2-13), NaN guard; clumps
-//                   sum their members' forces and moments (Eq 2-44, 2-46) and
-//                   move as rigid bodies (src/rigid_body.h), members follow
-//   7. watchdog     overlap limit every step, energy every check_interval steps
+//   1. prepare       gravity schedule, wall poses and activity at t; is a
+//                    neighbour rebuild due (a body or wall moved > skin/2)?
+//   2. neighbours    rebuild pair and wall-candidate lists when due (history
+//                    carried over); relaxation offsets of initial overlaps
+//   3. forces        contact law at every pair and wall contact, summed per ball
+//                    in a fixed order; on steps that nothing observes and with no
+//                    force contributions, fused with the kick and drift (stage 7)
+//   4. extra forces  force contributions (force_contribution.h, e.g. bonds) add
+//                    into the accumulators in a fixed order; only when present
+//   5. observe       only on observed steps: velocities synchronised to t, energy
+//   6. watchdog      overlap limit (every step); energy growth and the contact
+//                    network's step when due (observed steps)
+//   7. integrate     leapfrog kick and drift (Eq 2-11..2-13), local damping,
+//                    clumps as rigid bodies (Eq 2-44..2-46); clock; NaN guard
 //
-// Threads: stages 3, 4 and 6 run over balls with OpenMP static schedules; every
+// The observer is called between stages 6 and 7 with the whole-step snapshot.
+// Threads: stages 2, 3 and 7 run over balls with OpenMP static schedules; every
 // ball's sums are formed in the same order whatever the number of threads.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -24,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "rocklab/sim/force_contribution.h"
 #include "rocklab/sim/model.h"
 #include "rocklab/sim/particles.h"
 #include "rocklab/sim/snapshot.h"
@@ -62,6 +69,12 @@ struct WorldState {
   std::vector<WallHistory> wall_history;
 };
 
+/// The stages of one step, in their order (see the head of this file).
+enum class Stage { Prepare, Neighbours, Forces, ExtraForces, Observe, Watchdog, Integrate, Count };
+inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count);
+/// Stage names as results.json reports them ("prepare", "extra_forces", ...).
+const char* stageName(Stage s);
+
 struct WorldStats {
   std::uint64_t neighbour_rebuilds = 0;
   std::size_t pairs_in_list = 0;
@@ -69,6 +82,7 @@ struct WorldStats {
   double neighbour_seconds = 0.0;  // s of wall time spent in neighbour-list rebuilds
   std::uint64_t network_checks = 0;  // step checks of the contact network done
   double network_step_ratio = 0.0;   // largest dt / (stable step of the network) they found; stops above 1
+  std::array<double, kStageCount> stage_seconds{};  // s of wall time per Stage (index = Stage)
 };
 
 class World {
@@ -99,6 +113,11 @@ class World {
   /// Threads the step really uses: the requested ones, fewer for small worlds.
   int threads() const;
   Vec3 gravity() const;
+
+  /// Adds forces other than contacts (force_contribution.h); called in the
+  /// `extra forces` stage in the order added. A world with contributions no
+  /// longer fuses integration into the contact pass.
+  void addForceContribution(std::shared_ptr<ForceContribution> contribution);
 
   /// Saves everything needed to continue bit for bit.
   WorldState exportState() const;

@@ -1,0 +1,195 @@
+#include "../world_impl.h"
+
+
+namespace rocklab::sim {
+
+using detail::PairProps;
+
+// Stage 3, forces: the contact law at every pair and wall contact, gathered per
+// ball; on fused steps (StepPlan::fused) with the kick and drift of stage 7.
+// Reads: positions, velocities, spins (t - dt/2), radii, materials, nb, walls.
+// Writes: scratch.acc_force/acc_torque (set outright), history (shear springs,
+// touching flags), the watchdog's wall work, the step checks; on fused steps
+// the integrated state as stage 7 would.
+// The contact law, the pass and its caller are in this one unit so that
+// evaluatePair and addWallForces inline into the pass.
+//
+// Each thread owns a contiguous range of balls [b, e). A pair (i, j), i < j, is
+// evaluated once. Its force on j is added straight into j's accumulator when j is
+// in the same range; when j lies in a later range the pair is a "cross" pair,
+// evaluated first (phase A, before a barrier) into a slot that both threads read.
+// Every ball then receives its contributions in one fixed order — from the pairs
+// (i', p) in ascending i', then its own row in ascending j, then its walls — on
+// any number of threads, so results are bitwise independent of the thread count.
+// A ball is complete once its own row is done (later balls never read it in this
+// step), so it is integrated right there unless an observer needs the forces.
+
+template <class Law>
+[[gnu::always_inline]] inline bool World::Impl::evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj,
+                                      Vec3& tj, StepChecks& c) {
+  const std::uint32_t j = nb.pairs.partner[k];
+  const Vec3 xi = p.position[i];
+  const Vec3 d = p.position[j] - xi;
+  const double ri = p.radius[i], rj = p.radius[j];
+  const double rsum = ri + rj;
+  const double dist2 = d.squaredNorm();
+  if (dist2 >= rsum * rsum) {
+    history.pair_touch[k] = 0;
+    history.pair_shear[k].setZero();
+    if (relax.active()) relax.pair[k] = 0.0;  // separated: a new touch gets the full force
+    return false;
+  }
+  const double dist = std::sqrt(dist2);
+  detail::ContactGeometry g;
+  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
+  g.overlap = rsum - dist;
+  const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point: middle of the overlap
+  if (relax.active()) {
+    // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
+    g.overlap -= relax.factor * relax.pair[k];
+    if (g.overlap <= 0) {
+      history.pair_touch[k] = 0;
+      history.pair_shear[k].setZero();
+      return false;
+    }
+  }
+  const Vec3 ai = cp - xi, aj = cp - p.position[j];
+  g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
+  g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
+  const double mi = p.mass[i], mj = p.mass[j];
+  g.damping_mass = detail::dampingMass(model.contact.damping_mass, mi, mj);
+  const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
+  const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, history.pair_shear[k]);
+  fi = res.force;
+  ti = ai.cross(res.force);
+  fj = -res.force;
+  tj = aj.cross(fj);
+  history.pair_touch[k] = 1;
+  const double r_small = std::min(ri, rj);
+  if (g.overlap > model.watchdog.max_overlap_fraction * r_small)
+    mergeWorst(c, g.overlap / r_small, (std::uint64_t(i) << 32) | j);
+  return true;
+}
+
+template <class Law>
+inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c) {
+  const Vec3 xi = p.position[i];
+  const double ri = p.radius[i];
+  for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
+    const std::uint32_t wk = nb.wall_index[w];
+    const detail::WallRuntime& wr = walls[wk];
+    detail::WallContact wc;
+    if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
+      history.wall_touch[w] = 0;
+      history.wall_shear[w].setZero();
+      if (relax.active()) relax.wall[w] = 0.0;
+      continue;
+    }
+    detail::ContactGeometry g;
+    g.normal = wc.normal;
+    g.overlap = wc.overlap;
+    const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
+    if (relax.active()) {
+      g.overlap -= relax.factor * relax.wall[w];
+      if (g.overlap <= 0) {
+        history.wall_touch[w] = 0;
+        history.wall_shear[w].setZero();
+        continue;
+      }
+    }
+    const Vec3 ai = cp - xi;
+    const Vec3 v_wall = wr.velocityAt(cp);
+    g.rel_velocity = v_wall - (p.velocity[i] + p.omega[i].cross(ai));
+    g.r_tilde = ri;            // mirror-image ball (ref §4.2)
+    g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)
+    const PairProps& props =
+        ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wk].material)];
+    const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, history.wall_shear[w]);
+    f += res.force;
+    t += ai.cross(res.force);
+    history.wall_touch[w] = 1;
+    if (!guard.wall_work.empty() && guard.wall_moving[wk]) {
+      // Power of the wall on the ball, F . v_wall (the energy watchdog's work input).
+      const double dw = dt * res.force.dot(v_wall);
+      guard.wall_work[i] += dw;
+      guard.wall_work_gross[i] += std::abs(dw);
+    }
+    if (g.overlap > model.watchdog.max_overlap_fraction * ri)
+      mergeWorst(c, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
+  }
+}
+
+template <class Law>
+void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
+  const int team = static_cast<int>(scratch.range_begin.size()) - 1;
+  // Clump members are integrated with their clump after the pass. A local copy:
+  // the stores into the accumulators could alias the member flag otherwise.
+  const std::int32_t* const clump_of = has_clumps ? p.clump.data() : nullptr;
+#pragma omp parallel num_threads(team)
+  {
+    const int th = omp_get_thread_num();
+    const std::uint32_t b = scratch.range_begin[th], e = scratch.range_begin[th + 1];
+    StepChecks local;
+    // Phase A: pairs whose second ball belongs to a later range.
+    for (std::uint32_t i = b; i < e; ++i)
+      for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
+        if (nb.pairs.partner[k] < e) continue;
+        ForceScratch::CrossSlot& s = scratch.cross[scratch.cross_index[k]];
+        evaluatePair<Law>(i, k, s.fi, s.ti, s.fj, s.tj, local);
+      }
+#pragma omp barrier
+    // Phase B: start every ball of the range with the cross contributions it
+    // receives (pairs (i', p), i' < b, ascending i').
+    for (std::uint32_t q = b; q < e; ++q) {
+      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
+      for (std::uint32_t c = nb.pairs.col_offset[q]; b > 0 && c < nb.pairs.col_offset[q + 1]; ++c) {
+        const std::uint32_t k = nb.pairs.col_pair[c];
+        if (scratch.cross_index[k] == ForceScratch::kNotCross) break;  // the rest come from this range
+        if (!history.pair_touch[k]) continue;
+        f += scratch.cross[scratch.cross_index[k]].fj;
+        t += scratch.cross[scratch.cross_index[k]].tj;
+      }
+      scratch.acc_force[q] = f;
+      scratch.acc_torque[q] = t;
+    }
+    // ...then every ball's own row (scattering to partners in the range) and walls.
+    for (std::uint32_t i = b; i < e; ++i) {
+      Vec3 f = scratch.acc_force[i], t = scratch.acc_torque[i];
+      for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
+        if (scratch.cross_index[k] != ForceScratch::kNotCross) {
+          if (!history.pair_touch[k]) continue;
+          f += scratch.cross[scratch.cross_index[k]].fi;
+          t += scratch.cross[scratch.cross_index[k]].ti;
+          continue;
+        }
+        Vec3 fi, ti, fj, tj;
+        if (!evaluatePair<Law>(i, k, fi, ti, fj, tj, local)) continue;
+        f += fi;
+        t += ti;
+        const std::uint32_t j = nb.pairs.partner[k];
+        scratch.acc_force[j] += fj;
+        scratch.acc_torque[j] += tj;
+      }
+      addWallForces<Law>(i, f, t, local);
+      if (integrate_now && !(clump_of && clump_of[i] >= 0)) {
+        integrate(i, f, t, h, local);
+      } else {
+        scratch.acc_force[i] = f;
+        scratch.acc_torque[i] = t;
+      }
+    }
+#pragma omp critical
+    mergeChecks(merged, local);
+  }
+}
+
+void World::Impl::forceStage(const StepPlan& plan, StepChecks& checks) {
+  if (model.contact.law == ContactLaw::Linear)
+    forcePass<detail::LinearLaw>(plan.fused, plan.kick, checks);
+  else
+    forcePass<detail::HertzMindlinLaw>(plan.fused, plan.kick, checks);
+  // Clumps sum their members' forces once every member is complete.
+  if (plan.fused && has_clumps) integrateClumps(plan.kick, checks);
+}
+
+}  // namespace rocklab::sim

@@ -1,0 +1,99 @@
+#include "../world_impl.h"
+
+
+namespace rocklab::sim {
+
+using detail::PairProps;
+
+// Stage 2, neighbours.
+// Reads: positions, radii, clump membership, wall poses; the old lists.
+// Writes: nb (pair list, wall candidates, reference positions), the contact
+// history and relaxation offsets carried over to the new lists, the thread
+// ranges and cross-pair slots of the force pass (scratch); relaxation factor.
+
+void World::Impl::neighbourStage() {
+  if (nb.need_rebuild) rebuildNeighbours();
+  if (relax.pending) startRelaxation();
+  if (relax.active()) updateRelaxation();
+}
+
+void World::Impl::rebuildNeighbours() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = p.size();
+  detail::PairList old = std::move(nb.pairs);
+  std::vector<Vec3> old_shear = std::move(history.pair_shear);
+  std::vector<double> old_relax = std::move(relax.pair);
+  const bool carry_relax = !old_relax.empty();
+  nb.finder.build(p.position, p.radius, nb.skin, teamSize(), nb.pairs, model.max_grid_levels, p.clump);
+  const std::size_t np = nb.pairs.size();
+  history.pair_shear.assign(np, Vec3::Zero());
+  history.pair_touch.assign(np, 0);
+  if (carry_relax) relax.pair.assign(np, 0.0);
+  // Carry shear history over by merging old and new rows (both sorted by j).
+  if (!old.row_offset.empty()) {
+#pragma omp parallel for schedule(static) num_threads(teamSize())
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint32_t a = old.row_offset[i], b = nb.pairs.row_offset[i];
+      const std::uint32_t ae = old.row_offset[i + 1], be = nb.pairs.row_offset[i + 1];
+      while (a < ae && b < be) {
+        if (old.partner[a] < nb.pairs.partner[b]) ++a;
+        else if (old.partner[a] > nb.pairs.partner[b]) ++b;
+        else {
+          if (carry_relax) relax.pair[b] = old_relax[a];
+          history.pair_shear[b++] = old_shear[a++];
+        }
+      }
+    }
+  }
+  // Wall candidates: balls within r + skin of an active wall.
+  std::vector<std::uint32_t> old_offset = std::move(nb.wall_offset), old_index = std::move(nb.wall_index);
+  std::vector<Vec3> old_wshear = std::move(history.wall_shear);
+  std::vector<double> old_wrelax = std::move(relax.wall);
+  nb.wall_offset.assign(n + 1, 0);
+  nb.wall_index.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < walls.size(); ++k) {
+      if (!walls[k].active) continue;
+      if (walls[k].distance(model.walls[k], p.position[i]) < p.radius[i] + nb.skin)
+        nb.wall_index.push_back(static_cast<std::uint32_t>(k));
+    }
+    nb.wall_offset[i + 1] = static_cast<std::uint32_t>(nb.wall_index.size());
+  }
+  history.wall_shear.assign(nb.wall_index.size(), Vec3::Zero());
+  history.wall_touch.assign(nb.wall_index.size(), 0);
+  if (carry_relax) relax.wall.assign(nb.wall_index.size(), 0.0);
+  if (!old_offset.empty()) {
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c)
+        for (std::uint32_t o = old_offset[i]; o < old_offset[i + 1]; ++o)
+          if (old_index[o] == nb.wall_index[c]) {
+            history.wall_shear[c] = old_wshear[o];
+            if (carry_relax) relax.wall[c] = old_wrelax[o];
+          }
+  }
+  nb.ref_position = p.position;
+  for (auto& wr : walls) wr.setReference();
+  nb.last_max_disp2 = 0.0;
+  nb.need_rebuild = false;
+  assignRanges();
+  ++stats.neighbour_rebuilds;
+  stats.pairs_in_list = np;
+  stats.wall_candidates = nb.wall_index.size();
+  stats.neighbour_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void World::Impl::assignRanges() {
+  const std::size_t n = p.size();
+  const int team = teamSize();
+  scratch.range_begin.resize(static_cast<std::size_t>(team) + 1);
+  for (int t = 0; t <= team; ++t) scratch.range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
+  scratch.cross_index.assign(nb.pairs.size(), ForceScratch::kNotCross);
+  std::uint32_t slots = 0;
+  for (int t = 0; t < team; ++t)
+    for (std::uint32_t i = scratch.range_begin[t]; i < scratch.range_begin[t + 1]; ++i)
+      for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k)
+        if (nb.pairs.partner[k] >= scratch.range_begin[t + 1]) scratch.cross_index[k] = slots++;
+  scratch.cross.resize(slots);
+}
+
+}  // namespace rocklab::sim

@@ -1,0 +1,58 @@
+#include "../world_impl.h"
+
+
+namespace rocklab::sim {
+
+using detail::PairProps;
+
+/// Takes every touching contact's overlap as its relaxation offset (first step
+/// of a world built with Model::relaxation.steps > 0).
+void World::Impl::startRelaxation() {
+  relax.pending = false;
+  relax.pair.assign(nb.pairs.size(), 0.0);
+  relax.wall.assign(nb.wall_index.size(), 0.0);
+  bool any = false;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
+      const std::uint32_t j = nb.pairs.partner[k];
+      const double overlap = p.radius[i] + p.radius[j] - (p.position[j] - p.position[i]).norm();
+      if (overlap > 0) {
+        relax.pair[k] = overlap;
+        any = true;
+      }
+    }
+    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
+      const std::uint32_t wk = nb.wall_index[c];
+      detail::WallContact wc;
+      if (walls[wk].active && walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc) &&
+          wc.overlap > 0) {
+        relax.wall[c] = wc.overlap;
+        any = true;
+      }
+    }
+  }
+  if (!any) {
+    relax.pair.clear();
+    relax.wall.clear();
+  }
+}
+
+/// Offset factor of this step; frees the offsets once the relaxation is over.
+void World::Impl::updateRelaxation() {
+  const auto n = static_cast<std::uint64_t>(std::max(0, model.relaxation.steps));
+  if (step >= n) {
+    relax.pair.clear();
+    relax.pair.shrink_to_fit();
+    relax.wall.clear();
+    relax.wall.shrink_to_fit();
+    guard.energy_ref_valid = false;  // the energy check starts afresh from the relaxed state
+    return;
+  }
+  // Smoothstep: the offset starts and ends shrinking at zero rate, so the bodies
+  // are not jerked into motion at the start nor left moving at the end (a linear
+  // ramp leaves them with up to twice its rate). Peak rate 1.5 x offset / (n dt).
+  const double x = static_cast<double>(step) / static_cast<double>(n);
+  relax.factor = 1.0 - x * x * (3.0 - 2.0 * x);
+}
+
+}  // namespace rocklab::sim

@@ -1,0 +1,235 @@
+#pragma once
+// World::Impl: the engine's state, grouped by the stage that owns it, and the
+// stage functions (one file each in src/stages/). Internal to rocklab_sim.
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "contact_kernel.h"
+#include "contact_spectrum.h"
+#include "neighbor_list.h"
+#include "rocklab/sim/world.h"
+#include "wall_runtime.h"
+
+namespace rocklab::sim {
+
+// Reduction of the per-step checks; merged in a thread-independent way (max, or).
+struct StepChecks {
+  double max_disp2 = 0.0;        // m^2, largest squared displacement since the last rebuild
+  bool non_finite = false;
+  double worst_overlap = 0.0;    // overlap / smaller radius
+  std::uint64_t worst_key = 0;   // (i << 32 | j) of that contact; j = kWallBit | wall for walls
+};
+inline constexpr std::uint64_t kWallBit = 1ull << 31;
+
+inline void mergeWorst(StepChecks& into, double ratio, std::uint64_t key) {
+  if (ratio > into.worst_overlap || (ratio == into.worst_overlap && ratio > 0 && key < into.worst_key)) {
+    into.worst_overlap = ratio;
+    into.worst_key = key;
+  }
+}
+
+/// Folds one thread's checks into the step's (call inside `omp critical`).
+inline void mergeChecks(StepChecks& into, const StepChecks& from) {
+  mergeWorst(into, from.worst_overlap, from.worst_key);
+  into.max_disp2 = std::max(into.max_disp2, from.max_disp2);
+  into.non_finite = into.non_finite || from.non_finite;
+}
+
+/// Four significant digits, for messages.
+std::string fmtNum(double x);
+
+/// Adds the wall time of its scope to one stage's counter.
+class StageTimer {
+ public:
+  explicit StageTimer(double& seconds) : seconds_(seconds), start_(std::chrono::steady_clock::now()) {}
+  ~StageTimer() { seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  double& seconds_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// What this step has to do besides stepping (decided once, before the forces).
+struct StepPlan {
+  double kick = 0.0;           // s, the kick's length: dt/2 at the first step, else dt
+  bool energy_due = false;     // the watchdog's energy check
+  bool network_due = false;    // the contact-network step check
+  bool observe = false;        // velocities synchronised to t and the energy are needed
+  bool fused = false;          // integration runs inside the contact pass (stage 3)
+};
+
+struct World::Impl {
+  // --- the world: constant model, particles, clock
+  Model model;
+  ParticleState p;
+  int threads = 1;
+  double time = 0.0;
+  std::uint64_t step = 0;
+  double dt = 0.0;
+  bool half_kick_pending = true;
+  Vec3 gravity = Vec3::Zero();
+  TimestepAudit audit;
+  WorldStats stats;
+  bool has_clumps = false;
+  bool isMember(std::size_t i) const { return has_clumps && p.clump[i] >= 0; }
+  // Material-pair constants: ball_ball[a * nm + b], ball_wall[ball * nm + wall].
+  std::vector<detail::PairProps> ball_ball, ball_wall;
+  std::size_t nm = 0;
+  std::vector<detail::WallRuntime> walls;  // pose and activity at t (stage 1)
+  std::vector<std::shared_ptr<ForceContribution>> contributions;  // stage 4, in this order
+
+  // --- neighbour lists (stage 2 writes, stages 3-6 read)
+  struct NeighbourLists {
+    detail::NeighborFinder finder;
+    detail::PairList pairs;                  // ball–ball pairs, canonical CSR
+    std::vector<std::uint32_t> wall_offset;  // [n+1] ball–wall candidates in rows by ball
+    std::vector<std::uint32_t> wall_index;   // [k] wall of each candidate
+    std::vector<Vec3> ref_position;          // [n] m, positions at the last rebuild
+    double skin = 0.0;                       // m
+    bool need_rebuild = true;
+    double last_max_disp2 = 0.0;             // m^2, largest displacement since the rebuild
+  } nb;
+
+  // --- contact history (stage 3 writes; carried over by stage 2, saved by exportState)
+  struct ContactHistory {
+    std::vector<Vec3> pair_shear;            // [pairs] N, shear spring force on i
+    std::vector<std::uint8_t> pair_touch;    // [pairs] 1 when touching at this step
+    std::vector<Vec3> wall_shear;            // [k] N, on the ball
+    std::vector<std::uint8_t> wall_touch;    // [k]
+  } history;
+
+  // --- force scratch (stages 3 and 4 write, 5 and 7 read)
+  struct ForceScratch {
+    struct CrossSlot {
+      Vec3 fi, ti, fj, tj;  // N, N m on the first and the second ball
+    };
+    static constexpr std::uint32_t kNotCross = 0xffffffffu;
+    std::vector<std::uint32_t> range_begin;  // [team+1] balls of each thread
+    std::vector<std::uint32_t> cross_index;  // [pairs] slot of a pair crossing two ranges, or kNotCross
+    std::vector<CrossSlot> cross;
+    std::vector<Vec3> acc_force, acc_torque;  // [n] N, N m: contacts and contributions, no gravity
+  } scratch;
+
+  // --- observation (stage 5 writes on observed steps)
+  struct Observation {
+    std::vector<Vec3> velocity, omega;              // [n] synchronised to t
+    std::vector<Vec3> clump_velocity, clump_omega;  // [c]
+    std::vector<Vec3> clump_force;                  // [c] N, total incl. gravity
+    Energy energy;
+  } obs;
+
+  // --- watchdog (stage 6)
+  struct Guard {
+    bool energy_ref_valid = false;
+    double energy_ref = 0.0, energy_scale = 0.0;  // J
+    // Work done on each ball by moving walls since the energy reference (J), net
+    // and gross (sum of |dW|); empty when no wall moves. Per ball, so the sums do
+    // not depend on the number of threads.
+    std::vector<double> wall_work, wall_work_gross;
+    std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
+    detail::SpectrumEstimate spectrum;      // fastest network mode, kept between checks
+    detail::ContactNetwork network;         // rebuilt at every check (buffers reused)
+  } guard;
+
+  // --- relaxation of initial overlaps (Model::relaxation); empty when off or done
+  struct Relaxation {
+    std::vector<double> pair;  // [pairs] m, initial overlap of the pair (offset at factor 1)
+    std::vector<double> wall;  // [k] m, the same for ball–wall candidates
+    bool pending = false;      // offsets still to be taken at the first step
+    double factor = 0.0;       // offset / initial overlap at this step (1 -> 0, smoothstep)
+    bool active() const { return !pair.empty(); }
+  } relax;
+
+  // Below this many balls per thread a second thread does not pay: a step of a
+  // few thousand balls takes tens of microseconds, and waking the team, the
+  // barrier and the cross-range pairs cost as much (measured: the 1500-ball demo
+  // ran 1.65x slower on 2 threads, while 2000 lattice balls ran 1.7x faster, and
+  // 16000 balls 1.5-1.9x faster). Results are bitwise the same whatever the team.
+  static constexpr std::size_t kMinBallsPerThread = 2500;
+  int teamSize() const {
+    const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
+    return std::max(1, std::min(threads, useful));
+  }
+  double& stageSeconds(Stage s) { return stats.stage_seconds[static_cast<std::size_t>(s)]; }
+
+  // Set-up (world_setup.cpp).
+  void initialise(int requested_threads);
+  void buildPairProps();
+  void placeMembers(std::size_t c);
+  void restoreHistory(const WorldState& state);
+
+  // One step (world.cpp): the stages in order.
+  void doStep(const std::function<void(const Snapshot&)>& observer);
+  StepPlan planStep(bool observed) const;
+
+  // 1. prepare (stages/prepare.cpp)
+  void prepareStage();
+  // 2. neighbours (stages/neighbours.cpp, stages/relaxation.cpp)
+  void neighbourStage();
+  void rebuildNeighbours();
+  void assignRanges();
+  void startRelaxation();
+  void updateRelaxation();
+  // 3. forces (stages/forces.cpp: the contact law and the pass in one unit, so it inlines)
+  void forceStage(const StepPlan& plan, StepChecks& checks);
+  template <class Law>
+  bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
+  template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
+  template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
+  // 4. extra forces (stages/extra_forces.cpp)
+  void extraForceStage();
+  ForceInput forceInput() const { return ForceInput{time, dt, p}; }
+  // 5. observe (stages/observe.cpp, stages/energy.cpp)
+  void observeStage();
+  Snapshot snapshot(std::vector<Vec3>& total_force, std::vector<std::uint8_t>& wall_active) const;
+  void clumpLoad(std::size_t c, Vec3& force, Vec3& torque) const;
+  Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
+  template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
+  // 6. watchdog (stages/watchdog.cpp, stages/network_check.cpp)
+  void watchdogStage(const StepPlan& plan, const StepChecks& checks);
+  void checkOverlap(const StepChecks& checks) const;
+  void checkFinite() const;
+  void checkEnergy(const Energy& e);
+  bool energyCheckApplies() const;
+  void checkNetworkStep();
+  template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
+  std::string stepAdvice() const;
+  // 7. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)
+  void integrateStage(const StepPlan& plan, StepChecks& checks);
+  void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
+  void integrateClumps(double h, StepChecks& merged);
+  void finishStep(const StepChecks& checks);
+};
+
+/// Kick and drift of one free ball (Eq 2-11..2-13, local damping Eq 2-15).
+/// Inline: the contact pass (stage 3) fuses it on unobserved steps.
+inline void World::Impl::integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h,
+                                   StepChecks& c) {
+  const double inv_m = p.inv_mass[i];
+  Vec3 f = f_contact + gravity / inv_m;  // generalised force incl. gravity (Eq 2-14)
+  Vec3 t = torque;
+  const double alpha = model.contact.local_damping;
+  if (alpha > 0) {
+    // Cundall's local damping, Eq 2-15 in its sign form: -alpha |F| sign(v) per component.
+    for (int a = 0; a < 3; ++a) {
+      f[a] -= alpha * std::abs(f[a]) * ((p.velocity[i][a] > 0) - (p.velocity[i][a] < 0));
+      t[a] -= alpha * std::abs(t[a]) * ((p.omega[i][a] > 0) - (p.omega[i][a] < 0));
+    }
+  }
+  p.velocity[i] += (h * inv_m) * f;          // Eq 2-11
+  p.omega[i] += (h * p.inv_inertia[i]) * t;  // Eq 2-12 (sphere: no gyroscopic term)
+  p.position[i] += dt * p.velocity[i];       // Eq 2-13
+  if (!p.position[i].allFinite() || !p.velocity[i].allFinite()) c.non_finite = true;
+  c.max_disp2 = std::max(c.max_disp2, (p.position[i] - nb.ref_position[i]).squaredNorm());
+}
+
+}  // namespace rocklab::sim

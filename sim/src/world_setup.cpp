@@ -1,0 +1,276 @@
+#include "world_impl.h"
+
+#include <numbers>
+#include <sstream>
+
+#include "rigid_body.h"
+#include "rocklab/sim/wall_motion.h"
+
+namespace rocklab::sim {
+
+using detail::PairProps;
+
+// ---------------------------------------------------------------------------
+// Set-up
+
+std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres,
+                          const std::vector<ClumpSpec>& clumps) {
+  std::ostringstream e;
+  if (model.materials.empty()) return "no materials defined";
+  if (model.relaxation.steps < 0) return "relaxation.steps must be >= 0";
+  for (std::size_t k = 0; k < model.materials.size(); ++k) {
+    const Material& m = model.materials[k];
+    const std::string where = "material '" + m.name + "'";
+    if (!(m.density > 0)) return where + ": density must be > 0 kg/m^3";
+    if (!(m.friction >= 0)) return where + ": friction must be >= 0";
+    if (model.contact.law == ContactLaw::Linear && !(m.kn > 0 && m.ks >= 0))
+      return where + ": the linear law needs kn > 0 and ks >= 0 N/m";
+    if (model.contact.law == ContactLaw::HertzMindlin &&
+        !(m.shear_modulus > 0 && m.poisson > -1 && m.poisson < 0.5))
+      return where + ": Hertz–Mindlin needs shear_modulus > 0 Pa and -1 < poisson < 0.5";
+  }
+  const auto nm = static_cast<int>(model.materials.size());
+  for (const Wall& w : model.walls) {
+    const std::string where = "wall '" + w.name + "'";
+    if (w.material < 0 || w.material >= nm) return where + ": unknown material";
+    if (w.shape == WallShape::Plane) {
+      if (!(w.normal.norm() > 0)) return where + ": normal must not be zero";
+      if (!w.motion.angular_velocity.isZero(0))
+        return where + ": an infinite plane cannot rotate; use a polygon";
+    }
+    if (w.shape == WallShape::Polygon) {
+      if (w.vertices.size() < 3) return where + ": a polygon needs at least 3 vertices";
+      const Vec3 nrm = polygonNormal(w.vertices);
+      if (!(nrm.norm() > 0)) return where + ": the first three vertices are collinear";
+      const double scale = (w.vertices[1] - w.vertices[0]).norm();
+      for (const Vec3& v : w.vertices)
+        if (std::abs((v - w.vertices[0]).dot(nrm)) > 1e-9 * std::max(1.0, scale))
+          return where + ": the vertices are not in one plane";
+    }
+    if (w.shape == WallShape::Mesh) {
+      const std::string msg = w.mesh.validate();
+      if (!msg.empty()) return where + ": " + msg;
+    }
+    if (!(w.active_until > w.active_from)) return where + ": active_until must be after active_from";
+  }
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    const SphereSpec& s = spheres[i];
+    if (!(s.radius > 0)) {
+      e << "sphere " << i << ": radius must be > 0 m";
+      return e.str();
+    }
+    if (s.material < 0 || s.material >= nm) {
+      e << "sphere " << i << ": unknown material index " << s.material;
+      return e.str();
+    }
+    if (!s.position.allFinite() || !s.velocity.allFinite() || !s.omega.allFinite()) {
+      e << "sphere " << i << ": position, velocity and omega must be finite";
+      return e.str();
+    }
+  }
+  for (std::size_t c = 0; c < clumps.size(); ++c) {
+    const ClumpSpec& k = clumps[c];
+    e.str("");
+    e << "clump " << c << ": ";
+    if (k.members.empty()) return e.str() + "has no member spheres";
+    if (!(k.mass > 0)) return e.str() + "mass must be > 0 kg";
+    if (!(k.principal_inertia.minCoeff() > 0) || !k.principal_inertia.allFinite())
+      return e.str() + "principal inertia must be > 0 kg m^2";
+    if (k.material < 0 || k.material >= nm) return e.str() + "unknown material index";
+    if (!k.position.allFinite() || !k.velocity.allFinite() || !k.omega.allFinite() ||
+        !k.orientation.coeffs().allFinite() || std::abs(k.orientation.norm() - 1.0) > 1e-9)
+      return e.str() + "position, velocity and omega must be finite and the orientation a unit quaternion";
+    for (const geometry::Sphere& m : k.members)
+      if (!(m.radius > 0) || !m.centre.allFinite()) return e.str() + "member radius must be > 0 m";
+  }
+  return {};
+}
+
+World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
+    : World(std::move(model), spheres, {}, threads) {}
+
+World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
+             int threads)
+    : impl_(std::make_unique<Impl>()) {
+  const std::string msg = validateModel(model, spheres, clumps);
+  if (!msg.empty()) throw std::invalid_argument(msg);
+  Impl& w = *impl_;
+  w.model = std::move(model);
+  ParticleState& p = w.p;
+  std::size_t members = 0;
+  for (const ClumpSpec& c : clumps) members += c.members.size();
+  const std::size_t n = spheres.size() + members;
+  p.position.resize(n);
+  p.velocity.resize(n);
+  p.omega.resize(n);
+  p.radius.resize(n);
+  p.inv_mass.resize(n);
+  p.inv_inertia.resize(n);
+  p.material.resize(n);
+  p.mass.resize(n);
+  p.id.resize(n);
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    const SphereSpec& s = spheres[i];
+    const double r = s.radius;
+    const double m = w.model.materials[s.material].density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    p.position[i] = s.position;
+    p.velocity[i] = s.velocity;  // at t = 0; the first kick is a half kick
+    p.omega[i] = s.omega;
+    p.radius[i] = r;
+    p.mass[i] = m;
+    p.inv_mass[i] = 1.0 / m;
+    p.inv_inertia[i] = 1.0 / (0.4 * m * r * r);  // Eq 2-8
+    p.material[i] = s.material;
+    p.id[i] = i;
+  }
+  if (!clumps.empty()) {
+    ClumpState& k = p.clumps;
+    p.clump.assign(n, -1);
+    k.member_begin.push_back(0);
+    std::size_t i = spheres.size();
+    for (std::size_t c = 0; c < clumps.size(); ++c) {
+      const ClumpSpec& s = clumps[c];
+      k.position.push_back(s.position);
+      k.velocity.push_back(s.velocity);
+      k.orientation.push_back(s.orientation.normalized());
+      k.angular_momentum.push_back(detail::angularMomentum(k.orientation.back(), s.principal_inertia, s.omega));
+      k.mass.push_back(s.mass);
+      k.inertia.push_back(s.principal_inertia);
+      k.id.push_back(n + c);  // ids after the balls': one id space for every body
+      for (const geometry::Sphere& m : s.members) {
+        p.radius[i] = m.radius;
+        p.mass[i] = s.mass;  // a member's dashpots and time-step criterion see the whole body
+        p.inv_mass[i] = 1.0 / s.mass;
+        p.inv_inertia[i] = 1.0 / s.principal_inertia.minCoeff();
+        p.material[i] = s.material;
+        p.id[i] = i;
+        p.clump[i] = static_cast<std::int32_t>(c);
+        k.member_ball.push_back(static_cast<std::uint32_t>(i));
+        k.member_offset.push_back(m.centre);
+        ++i;
+      }
+      k.member_begin.push_back(static_cast<std::uint32_t>(k.member_ball.size()));
+      w.placeMembers(c);
+    }
+  }
+  w.audit = auditTimestep(w.model, p);
+  w.dt = w.audit.chosen;
+  w.initialise(threads);
+  w.relax.pending = w.model.relaxation.steps > 0;
+}
+
+World::World(Model model, WorldState state, int threads) : impl_(std::make_unique<Impl>()) {
+  Impl& w = *impl_;
+  w.model = std::move(model);
+  const std::string msg = validateModel(w.model, {});
+  if (!msg.empty()) throw std::invalid_argument(msg);
+  w.p = std::move(state.particles);
+  w.time = state.time;
+  w.step = state.step;
+  w.half_kick_pending = state.half_kick_pending;
+  if (w.p.size() > 0) w.audit = auditTimestep(w.model, w.p);  // nothing to audit in an empty world
+  w.audit.chosen = state.dt;  // the run continues with the step it had
+  w.dt = state.dt;
+  w.initialise(threads);
+  // Contact history: build the lists now and take the saved shear forces.
+  w.prepareStage();
+  w.rebuildNeighbours();
+  for (const PairHistory& h : state.pair_history) {
+    const auto b = w.nb.pairs.partner.begin() + w.nb.pairs.row_offset[h.i];
+    const auto e = w.nb.pairs.partner.begin() + w.nb.pairs.row_offset[h.i + 1];
+    const auto it = std::lower_bound(b, e, h.j);
+    if (it == e || *it != h.j)
+      throw std::invalid_argument("checkpoint: contact history for a pair that is not in contact range");
+    w.history.pair_shear[it - w.nb.pairs.partner.begin()] = h.shear;
+    if (h.relax_offset > 0) {
+      if (w.relax.pair.empty()) {
+        w.relax.pair.assign(w.nb.pairs.size(), 0.0);
+        w.relax.wall.assign(w.nb.wall_index.size(), 0.0);
+      }
+      w.relax.pair[it - w.nb.pairs.partner.begin()] = h.relax_offset;
+    }
+  }
+  for (const WallHistory& h : state.wall_history) {
+    if (h.wall >= w.walls.size()) throw std::invalid_argument("checkpoint: wall contact history for a missing wall");
+    if (!w.walls[h.wall].active) continue;  // the wall was removed: its contacts went with it
+    bool found = false;
+    for (std::uint32_t c = w.nb.wall_offset[h.particle]; c < w.nb.wall_offset[h.particle + 1]; ++c)
+      if (w.nb.wall_index[c] == h.wall) {
+        w.history.wall_shear[c] = h.shear;
+        if (h.relax_offset > 0) {
+          if (w.relax.pair.empty()) {
+            w.relax.pair.assign(w.nb.pairs.size(), 0.0);
+            w.relax.wall.assign(w.nb.wall_index.size(), 0.0);
+          }
+          w.relax.wall[c] = h.relax_offset;
+        }
+        found = true;
+      }
+    if (!found)
+      throw std::invalid_argument("checkpoint: wall contact history for a ball out of wall range");
+  }
+}
+
+World::~World() = default;
+
+void World::Impl::initialise(int requested_threads) {
+  threads = requested_threads > 0 ? requested_threads : omp_get_max_threads();
+  has_clumps = p.clumps.size() > 0;
+  buildPairProps();
+  walls.resize(model.walls.size());
+  for (std::size_t k = 0; k < walls.size(); ++k) walls[k].setup(model.walls[k]);
+  guard.wall_moving.assign(walls.size(), 0);
+  bool any_moving = false;
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    guard.wall_moving[k] = model.walls[k].motion.isStatic() ? 0 : 1;
+    any_moving = any_moving || guard.wall_moving[k];
+  }
+  if (any_moving) {
+    guard.wall_work.assign(p.size(), 0.0);
+    guard.wall_work_gross.assign(p.size(), 0.0);
+  }
+  // Gravity in force at the current time.
+  gravity = model.gravity;
+  for (const GravityChange& g : model.gravity_changes)
+    if (g.time <= time) gravity = g.vector;
+  if (model.skin > 0) {
+    nb.skin = model.skin;
+  } else {
+    double sum = 0;
+    for (double r : p.radius) sum += r;
+    nb.skin = p.size() ? 0.2 * sum / static_cast<double>(p.size()) : 1e-3;
+  }
+  const std::size_t n = p.size();
+  scratch.acc_force.assign(n, Vec3::Zero());
+  scratch.acc_torque.assign(n, Vec3::Zero());
+  nb.need_rebuild = true;
+}
+
+void World::Impl::buildPairProps() {
+  nm = model.materials.size();
+  ball_ball.resize(nm * nm);
+  ball_wall.resize(nm * nm);
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = 0; b < nm; ++b) {
+      ball_ball[a * nm + b] = detail::ballBallProps(model.materials[a], model.materials[b]);
+      ball_wall[a * nm + b] = detail::ballWallProps(model.materials[a], model.materials[b]);
+    }
+}
+
+
+/// Sets the members' positions, velocities and spins from their clump's state.
+void World::Impl::placeMembers(std::size_t c) {
+  ClumpState& k = p.clumps;
+  const Quat q = k.orientation[c];
+  const Vec3 w = detail::angularVelocity(q, k.inertia[c], k.angular_momentum[c]);
+  for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
+    const std::uint32_t i = k.member_ball[m];
+    const Vec3 arm = q * k.member_offset[m];
+    p.position[i] = k.position[c] + arm;
+    p.velocity[i] = k.velocity[c] + w.cross(arm);
+    p.omega[i] = w;
+  }
+}
+
+
+}  // namespace rocklab::sim
