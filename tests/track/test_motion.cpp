@@ -23,7 +23,7 @@ TEST_CASE("pixelToPlane inverts Camera::project", "[track][plane]") {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   double worst = 0;
   for (const auto& [k1, k2] : {std::pair{0.0, 0.0}, std::pair{-0.1, 0.0}, std::pair{-0.25, 0.08}, std::pair{0.15, 0.0}}) {
-    const Camera camera = obliqueCamera(k1, k2);
+    const Camera camera = labCamera(kObliqueChuteView, k1, k2);
     for (int trial = 0; trial < 200; ++trial) {
       // A random plane through a random point in front of the camera.
       const Vec3 point(0.1 * uniform(rng), 0.1 * uniform(rng), 0.05 * uniform(rng));
@@ -39,7 +39,7 @@ TEST_CASE("pixelToPlane inverts Camera::project", "[track][plane]") {
   CHECK(worst < 1e-9);
 
   // No intersection: a plane behind the camera, or one containing the ray.
-  const Camera camera = obliqueCamera();
+  const Camera camera = labCamera(kObliqueChuteView, -0.1);
   const Vec3 behind = camera.position() - 0.5 * camera.pixelRay({320, 240});
   CHECK_FALSE(pixelToPlane(camera, {320, 240}, behind, camera.pixelRay({320, 240})));
   const Vec3 ray = camera.pixelRay({100, 100});
@@ -132,7 +132,7 @@ TEST_CASE("a synthetic red disc at constant velocity is tracked to 0.5 percent",
   SECTION("in metres through a posed camera with barrel distortion") {
     // The disc is drawn where the camera sees a point sliding along −x on the base
     // (z = 0) at 1.2 m/s; the tracker takes the pixels back to that plane.
-    const Camera camera = obliqueCamera(-0.1);
+    const Camera camera = labCamera(kObliqueChuteView, -0.1);
     const Vec3 start(0.06, 0.01, 0.0), velocity(-1.2, 0.0, 0.0);
     Linker linker;
     for (int k = 0; k < 60; ++k) {
