@@ -19,7 +19,8 @@ inline const CameraPose kSceneView{geometry::Vec3(0.1, -0.6, 0.25), geometry::Ve
 
 /// Looking down at about 38° on the chute base (z = 0) from the camera side (−y),
 /// as the lab camera sees the chute (the track tests).
-inline const CameraPose kObliqueChuteView{geometry::Vec3(0.05, -0.45, 0.35), geometry::Vec3(0.0, 0.0, 0.0)};
+inline const CameraPose kObliqueChuteView{geometry::Vec3(0.05, -0.45, 0.35),
+                                          geometry::Vec3(0.0, 0.0, 0.0)};
 
 /// 640×480, fx 800, fy 805, a little off-centre principal point, radial
 /// distortion k1, k2, the lab camera's frame rate, posed at `pose`.
