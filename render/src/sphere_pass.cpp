@@ -115,7 +115,6 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
   }
   points_ = instances_.size();
   quads_ = quadInstances_.size();
-  occluded_ = staged_.size() - points_ - quads_;
   instances_.insert(instances_.end(), quadInstances_.begin(), quadInstances_.end());
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(instances_.size() * sizeof(Instance)), instances_.data(),

@@ -29,10 +29,6 @@ class SpherePass {
               const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip, double dt);
   void draw(const ViewUniforms& view, const Canvas& canvas) const;
 
-  std::size_t drawnCount() const { return points_ + quads_; }
-  /// Spheres inside the view that the occlusion test dropped in the last upload.
-  std::size_t occludedCount() const { return occluded_; }
-
  private:
   struct Instance {        // 36 bytes per sphere on the GPU
     float sphere[4];       // camera-frame centre, radius (m)
@@ -56,7 +52,7 @@ class SpherePass {
   std::vector<std::uint32_t> order_;
   std::vector<Instance> instances_, quadInstances_;
   SphereCuller culler_;
-  std::size_t points_ = 0, quads_ = 0, occluded_ = 0;
+  std::size_t points_ = 0, quads_ = 0;
 };
 
 }  // namespace rocklab::render::detail

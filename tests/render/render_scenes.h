@@ -6,25 +6,15 @@
 
 #include "rocklab/geometry/camera.h"
 #include "rocklab/render/frame.h"
+#include "support/cameras.h"
 
 namespace rocklab::render::test {
 
 using geometry::Camera;
 using geometry::Vec2;
-
-/// 640×480, 800 px focal length, a little off-centre principal point, looking
-/// from (0.1, −0.6, 0.25) m at (0, 0, 0.05) m with z up: a posed, non-trivial camera.
-inline Camera labCamera(double k1 = 0.0, double k2 = 0.0) {
-  Camera c;
-  c.fx = 800.0;
-  c.fy = 805.0;
-  c.cx = 322.3;
-  c.cy = 236.8;
-  c.k1 = k1;
-  c.k2 = k2;
-  c.lookAt(Vec3(0.1, -0.6, 0.25), Vec3(0.0, 0.0, 0.05), Vec3(0, 0, 1));
-  return c;
-}
+using rocklab::test::CameraPose;
+using rocklab::test::kSceneView;
+using rocklab::test::labCamera;
 
 /// A box mesh [lo, hi] (12 triangles).
 inline std::shared_ptr<const geometry::TriangleMesh> boxMesh(const Vec3& lo, const Vec3& hi) {

@@ -78,7 +78,7 @@ TEST_CASE("rendered sphere centroids land on Camera::project and cv::projectPoin
   const double radiusPx = 8.0;  // image radius
   double worstMask = 0, worstWeighted = 0, worstOpenCv = 0, worstEllipse = 0;
   for (const auto& [k1, k2] : lenses) {
-    const Camera camera = labCamera(k1, k2);
+    const Camera camera = labCamera(kSceneView, k1, k2);
     RenderOptions flat;  // flat white discs: the weighted centroid sees coverage only
     flat.ambient = 1.0f;
     flat.diffuse = 0.0f;
@@ -124,7 +124,7 @@ TEST_CASE("rendered sphere centroids land on Camera::project and cv::projectPoin
 }
 
 TEST_CASE("the depth test hides what is behind and the Perspex wall tints what it covers", "[render]") {
-  const Camera camera = labCamera();
+  const Camera camera = labCamera(kSceneView);
   Renderer renderer(camera);
   const Vec3 target(0.0, 0.0, 0.05);
   const Vec3 toCamera = (camera.position() - target).normalized();
@@ -158,7 +158,7 @@ TEST_CASE("the depth test hides what is behind and the Perspex wall tints what i
 
 TEST_CASE("spheres cut by the image border and spheres wider than a point sprite are drawn whole", "[render]") {
   // A: the lab camera; B: the same view on a wider canvas, A's pixel (u, v) is B's (u + 60, v + 40).
-  const Camera a = labCamera();
+  const Camera a = labCamera(kSceneView);
   Camera b = a;
   b.width += 120;
   b.height += 80;

@@ -25,7 +25,7 @@ using namespace rocklab::render::test;
 namespace {
 
 Camera smallCamera() {
-  Camera c = labCamera();
+  Camera c = labCamera(kSceneView);
   c.width = 160;
   c.height = 120;
   c.fx = c.fy = 200.0;
@@ -59,7 +59,7 @@ TEST_CASE("no GL context exists before a Renderer and none after it", "[render]"
 }
 
 TEST_CASE("red markers and grey pebbles are separable by r minus g", "[render]") {
-  const Camera camera = labCamera();
+  const Camera camera = labCamera(kSceneView);
   const Vec3 marker(-0.03, 0, 0.02), pebble(0.03, 0, 0.02);
   const double radius = 0.015;
   FrameDescription frame;
@@ -92,13 +92,13 @@ TEST_CASE("red markers and grey pebbles are separable by r minus g", "[render]")
 
 TEST_CASE("two renders of the same frame are bitwise identical", "[render]") {
   const FrameDescription frame = tinyScene();
-  Renderer a(labCamera(-0.1, 0.02));
+  Renderer a(labCamera(kSceneView, -0.1, 0.02));
   const cv::Mat first = a.render(frame);
   CHECK(cv::norm(first, a.render(frame), cv::NORM_INF) == 0);
-  Renderer b(labCamera(-0.1, 0.02));  // a second context
+  Renderer b(labCamera(kSceneView, -0.1, 0.02));  // a second context
   CHECK(cv::norm(first, b.render(frame), cv::NORM_INF) == 0);
   // With every realism option on, too (noise seeded by the frame index).
-  Camera blurred = labCamera();
+  Camera blurred = labCamera(kSceneView);
   blurred.exposureTime = 1.0 / 1000;
   RenderOptions lab;
   lab.motionBlur = true;
@@ -140,7 +140,7 @@ TEST_CASE("the compatibility fallback draws the same image as the core profile",
 }
 
 TEST_CASE("motion blur smears a moving sphere along its velocity about the same centre", "[render]") {
-  Camera camera = labCamera();
+  Camera camera = labCamera(kSceneView);
   camera.exposureTime = 1.0 / 500;
   RenderOptions blur;
   blur.motionBlur = true;

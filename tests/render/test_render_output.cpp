@@ -83,7 +83,7 @@ TEST_CASE("movie writer writes a readable file and reports its codec", "[render]
 }
 
 TEST_CASE("overlays draw a time stamp and a true-length scale bar", "[render][output]") {
-  const Camera camera = labCamera();
+  const Camera camera = labCamera(kSceneView);
   cv::Mat image(camera.height, camera.width, CV_8UC3, cv::Scalar(0, 0, 0));
   drawTimestamp(image, 0.1234);
   CHECK(cv::countNonZero(image.reshape(1)) > 0);

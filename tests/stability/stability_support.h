@@ -18,10 +18,13 @@
 #include <vector>
 
 #include "rocklab/sim/world.h"
+#include "support/sim_builders.h"
 
 namespace rocklab::stab {
 
 using geometry::Vec3;
+using test::plane;
+using test::sphere;
 
 constexpr double kRock = 0.014;      // m, radius of a 28 mm rock (the crusher feed)
 constexpr double kFragment = 0.002;  // m, radius of a 4 mm fragment (smallest breakable size)
@@ -53,16 +56,6 @@ inline sim::Model hertz(double shear_modulus, double friction = 0.37, double bet
   return m;
 }
 
-inline sim::Wall plane(const std::string& name, Vec3 point, Vec3 normal, int material = 1) {
-  sim::Wall w;
-  w.name = name;
-  w.shape = sim::WallShape::Plane;
-  w.point = point;
-  w.normal = normal.normalized();
-  w.material = material;
-  return w;
-}
-
 /// Square polygon of half side `half` centred at `c`, facing +z.
 inline sim::Wall squareZ(const std::string& name, Vec3 c, double half, int material = 1) {
   sim::Wall w;
@@ -72,15 +65,6 @@ inline sim::Wall squareZ(const std::string& name, Vec3 c, double half, int mater
                 c + Vec3(-half, half, 0)};
   w.material = material;
   return w;
-}
-
-inline sim::SphereSpec ball(Vec3 x, double r, Vec3 v = Vec3::Zero(), int material = 0) {
-  sim::SphereSpec s;
-  s.position = x;
-  s.radius = r;
-  s.velocity = v;
-  s.material = material;
-  return s;
 }
 
 /// Largest overlap / smaller radius over ball pairs (members of one clump

@@ -27,12 +27,12 @@ Collision collide(const sim::Model& model, double r1, double r2, double v, doubl
   const double m1 = sphereMass(r1, model.materials[0].density), m2 = sphereMass(r2, model.materials[0].density);
   const double rs = r1 + r2;
   // Free flight of about 20 steps before the touch (the step does not depend on positions).
-  const double dt = sim::World(model, {ball({0, 0, 0}, r1), ball({1, 0, 0}, r2)}, 1).dt();
+  const double dt = sim::World(model, {sphere({0, 0, 0}, r1), sphere({1, 0, 0}, r2)}, 1).dt();
   const double gap = 20 * v * dt;
   const double y = b * rs;
   const double x = std::sqrt((rs + gap) * (rs + gap) - y * y);
-  std::vector<sim::SphereSpec> s{ball({0, 0, 0}, r1, Vec3(v * m2 / (m1 + m2), 0, 0)),
-                                 ball({x, y, 0}, r2, Vec3(-v * m1 / (m1 + m2), 0, 0))};
+  std::vector<sim::SphereSpec> s{sphere({0, 0, 0}, r1, Vec3(v * m2 / (m1 + m2), 0, 0)),
+                                 sphere({x, y, 0}, r2, Vec3(-v * m1 / (m1 + m2), 0, 0))};
   sim::World w(model, s, 1);
   Collision c;
   c.dt = w.dt();
@@ -168,7 +168,7 @@ TEST_CASE("friction 0 and 10: grazing impacts and a rock rolling on a floor", "[
     model.gravity = Vec3(0, 0, -9.81);
     model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
     const double r = kRock, m = sphereMass(r), static_overlap = m * 9.81 / 1e9;
-    sim::SphereSpec s = ball({0, 0, r - static_overlap}, r, {2.0, 0, 0});
+    sim::SphereSpec s = sphere({0, 0, r - static_overlap}, r, {2.0, 0, 0});
     s.omega = Vec3(0, -20.0, 0);  // backspin: w_y < 0 for motion along +x... rolling is w_y = v / r > 0
     sim::World w(model, {s}, 1);
     const Outcome o = run(w, 40000, 100);
@@ -196,8 +196,8 @@ TEST_CASE("damping 0 and 1: rock on a wall and on a rock at 5 m/s", "[stability]
     sim::Model model = linearPair(1e9, 0.37, beta);
     model.walls.push_back(plane("wall", Vec3::Zero(), Vec3::UnitX()));
     const double r = kRock;
-    const double dt = sim::World(model, {ball({1, 0, 0}, r)}, 1).dt();
-    sim::World w(model, {ball({r + 20 * 5.0 * dt, 0, 0}, r, {-5.0, 0, 0})}, 1);
+    const double dt = sim::World(model, {sphere({1, 0, 0}, r)}, 1).dt();
+    sim::World w(model, {sphere({r + 20 * 5.0 * dt, 0, 0}, r, {-5.0, 0, 0})}, 1);
     bool touched = false;
     const Outcome o = run(w, 100000, 1, [&](const sim::Snapshot& s) {
       if (s.position[0].x() < r) touched = true;
@@ -258,7 +258,7 @@ TEST_CASE("Hertz-Mindlin G from 1 kPa to 10 TPa: a rock resting on a floor under
     model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
     const double c = sim::hertzCoefficient(g, 0.2, r);
     const double d = std::pow(m * 9.81 / c, 2.0 / 3.0);
-    sim::World w(model, {ball({0, 0, r}, r)}, 1);  // just touching, released
+    sim::World w(model, {sphere({0, 0, r}, r)}, 1);  // just touching, released
     const Outcome o = run(w, 20000, 20);
     REQUIRE(o.finite);
     // Dropping from touch, the first dip reaches up to 2^(2/3) x the static overlap.
@@ -293,7 +293,7 @@ TEST_CASE("contact-network check: a rock stuck on a floor is stable just below i
   // Resting at its static overlap, nudged sideways at 0.1 mm/s to seed the
   // rolling mode (small enough to stick: ks dt v < 10 m g).
   const double nudge = 1e-4;
-  const std::vector<sim::SphereSpec> s{ball({0, 0, r - m * 9.81 / k}, r, {nudge, 0, 0})};
+  const std::vector<sim::SphereSpec> s{sphere({0, 0, r - m * 9.81 / k}, r, {nudge, 0, 0})};
   for (double f : {0.97, 1.03}) {
     INFO("dt = " << f << " x predicted");
     sim::Model on = model;

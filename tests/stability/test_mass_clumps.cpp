@@ -21,7 +21,7 @@ TEST_CASE("mass ratio 1e2 to 1e4: a light ball between two rocks on a floor", "[
     model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
     const double R = kRock, r = R / std::cbrt(ratio);
     const double z1 = R, z2 = z1 + R + r, z3 = z2 + r + R + 1e-6;
-    sim::World w(model, {ball({0, 0, z1}, R), ball({0, 0, z2}, r), ball({0, 0, z3}, R, {0, 0, -1.0})}, 1);
+    sim::World w(model, {sphere({0, 0, z1}, R), sphere({0, 0, z2}, r), sphere({0, 0, z3}, R, {0, 0, -1.0})}, 1);
     const Outcome o = run(w, 20000, 20);
     REQUIRE(o.finite);
     REQUIRE_FALSE(o.stopped);
@@ -48,7 +48,7 @@ TEST_CASE("damped cap: the old step (0.5 x critical) on the 1e4 fragment", "[sta
     model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
     const double R = kRock, r = R / std::cbrt(1e4);
     const double z1 = R, z2 = z1 + R + r, z3 = z2 + r + R + 1e-6;
-    std::vector<sim::SphereSpec> s{ball({0, 0, z1}, R), ball({0, 0, z2}, r), ball({0, 0, z3}, R, {0, 0, -1.0})};
+    std::vector<sim::SphereSpec> s{sphere({0, 0, z1}, R), sphere({0, 0, z2}, r), sphere({0, 0, z3}, R, {0, 0, -1.0})};
     const sim::TimestepAudit audit = sim::World(model, s, 1).timestepAudit();
     CHECK(audit.automatic < 0.5 * audit.critical);  // the cap binds
     model.timestep.dt = 0.5 * audit.critical;
@@ -88,7 +88,7 @@ void fragmentRidingWall(std::uint64_t steps, const std::string& name) {
   const double r = kFragment, k = 1e9 * 1e13 / (1e9 + 1e13), m = sphereMass(r);
   const double rest = m * 9.81 / k;
   const double w_peak = A * 2 * std::numbers::pi * f;
-  sim::World w(model, {ball({0, 0, r - rest}, r, {0, 0, w_peak})}, 1);  // moving with the wall
+  sim::World w(model, {sphere({0, 0, r - rest}, r, {0, 0, w_peak})}, 1);  // moving with the wall
   double worst_gap = 0.0, worst_overlap = 0.0;
   const Outcome o = run(w, steps, 10, [&](const sim::Snapshot& s) {
     const double z_wall = A * std::sin(2 * std::numbers::pi * f * s.time);
@@ -128,7 +128,7 @@ TEST_CASE("a wall squeezing a 4 mm fragment against the floor is stopped by the 
   std::swap(lid.vertices[1], lid.vertices[3]);  // face down
   lid.motion.velocity = Vec3(0, 0, -v);
   model.walls.push_back(lid);
-  sim::World w(model, {ball({0, 0, r}, r)}, 1);
+  sim::World w(model, {sphere({0, 0, r}, r)}, 1);
   const Outcome o = run(w, 100000, 1000);
   REQUIRE(o.finite);
   REQUIRE(o.stopped);
@@ -225,7 +225,7 @@ Outcome fragmentOnWallForced(double f, double& w_peak) {
   sim::Model model = fragmentOnOscillatingWall();
   w_peak = kWallAmplitude * 2 * std::numbers::pi * kWallFrequency;
   const double r = kFragment;
-  const std::vector<sim::SphereSpec> s{ball({0, 0, r}, r, {0, 0, w_peak})};
+  const std::vector<sim::SphereSpec> s{sphere({0, 0, r}, r, {0, 0, w_peak})};
   model.timestep.dt = f * sim::World(model, s, 1).timestepAudit().critical;
   model.timestep.allow_unsafe = true;
   sim::World w(model, s, 1);

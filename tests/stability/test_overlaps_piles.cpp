@@ -31,7 +31,7 @@ Release release(double fraction, int relax_steps, double k = 1e9) {
   // above); with relaxation the watchdog sees only the overlap beyond the offset.
   if (relax_steps == 0) model.watchdog.max_overlap_fraction = 0.6;
   const double r = kRock;
-  sim::World w(model, {ball({0, 0, 0}, r), ball({2 * r - fraction * r, 0, 0}, r)}, 1);
+  sim::World w(model, {sphere({0, 0, 0}, r), sphere({2 * r - fraction * r, 0, 0}, r)}, 1);
   Release rel;
   rel.dt = w.dt();
   rel.o = run(w, static_cast<std::uint64_t>(relax_steps) + 3000, 10);
@@ -84,7 +84,7 @@ TEST_CASE("initial overlap 10-50 % of the radius: eased apart with relaxation ov
 TEST_CASE("initial overlap 55 % of the radius: stopped at step 0 without relaxation - eased with it", "[stability]") {
   sim::Model model = linearPair(1e9, 0.37);
   const double r = kRock;
-  const std::vector<sim::SphereSpec> s{ball({0, 0, 0}, r), ball({2 * r - 0.55 * r, 0, 0}, r)};
+  const std::vector<sim::SphereSpec> s{sphere({0, 0, 0}, r), sphere({2 * r - 0.55 * r, 0, 0}, r)};
   {
     sim::World w(model, s, 1);
     const Outcome o = run(w, 10);
@@ -117,7 +117,7 @@ TEST_CASE("breakage replacement: a 4 mm fragment between two rocks overlapping b
     model.watchdog.max_overlap_fraction = 0.6;
     const double R = kRock, r = kFragment, d = 0.5 * r;
     const double z1 = R, z2 = z1 + R + r - d, z3 = z2 + r + R - d;
-    sim::World w(model, {ball({0, 0, z1}, R), ball({0, 0, z2}, r), ball({0, 0, z3}, R)}, 1);
+    sim::World w(model, {sphere({0, 0, z1}, R), sphere({0, 0, z2}, r), sphere({0, 0, z3}, R)}, 1);
     const Outcome o = run(w, static_cast<std::uint64_t>(relax) + 30000, 100, {}, relax == 0);
     REQUIRE(o.finite);
     REQUIRE_FALSE(o.stopped);
@@ -176,7 +176,7 @@ const sim::WorldState& settledPile() {
         const double r = 0.012 + 0.002 * std::fmod(n * 0.6180339887, 1.0);
         const double jx = 0.002 * std::fmod(n * 0.7548776662, 1.0) - 0.001;
         const double jy = 0.002 * std::fmod(n * 0.5698402910, 1.0) - 0.001;
-        s.push_back(ball({0.017 + 0.032 * i + jx, 0.017 + 0.032 * j + jy, 0.016 + 0.032 * k}, r));
+        s.push_back(sphere({0.017 + 0.032 * i + jx, 0.017 + 0.032 * j + jy, 0.016 + 0.032 * k}, r));
       }
   const sim::Model model = pileModel(0.11);
   sim::WorldState st;
@@ -342,8 +342,8 @@ TEST_CASE("relaxation survives a restart from the exported state bit for bit", "
   model.walls.push_back(plane("floor", Vec3::Zero(), Vec3::UnitZ()));
   model.relaxation.steps = 4000;
   const double r = kRock;
-  const std::vector<sim::SphereSpec> s{ball({0, 0, 0.6 * r}, r), ball({0, 0, 2.2 * r}, r),
-                                       ball({0.5 * r, 0, 3.6 * r}, r)};
+  const std::vector<sim::SphereSpec> s{sphere({0, 0, 0.6 * r}, r), sphere({0, 0, 2.2 * r}, r),
+                                       sphere({0.5 * r, 0, 3.6 * r}, r)};
   sim::World a(model, s, 1);
   for (int k = 0; k < 1500; ++k) a.step();
   const sim::WorldState mid = a.exportState();

@@ -48,7 +48,7 @@ render::FrameDescription scene(int k) {
 }  // namespace
 
 TEST_CASE("a rendered red sphere among grey pebbles is tracked to 1 percent of its velocity", "[track][end-to-end]") {
-  const Camera camera = obliqueCamera(-0.1);
+  const Camera camera = labCamera(kObliqueChuteView, -0.1);
   render::RenderOptions options;
   options.noiseSigma = 1.5;  // sensor noise, grey levels
   render::Renderer renderer(camera, options);

@@ -12,14 +12,17 @@
 #include "rocklab/geometry/packing.h"
 #include "rocklab/render/calibration_target.h"
 #include "rocklab/render/frame.h"
+#include "support/cameras.h"
 
 namespace rocklab::track::test {
 
 using geometry::Camera;
 using geometry::Vec2;
 using geometry::Vec3;
+using rocklab::test::kObliqueChuteView;
+using rocklab::test::labCamera;
 
-inline constexpr double kFrameRate = 500.0;  // frames/s, the lab camera
+inline constexpr double kFrameRate = rocklab::test::kLabFrameRate;  // frames/s
 inline const cv::Scalar kPaintedRed(40, 35, 190);  // BGR of a red marker in a photo
 
 /// A grey frame (level 120, Gaussian sensor noise of `noise` grey levels, seeded).
@@ -44,22 +47,6 @@ inline void drawDisc(cv::Mat& frame, cv::Point2d centre, double radius, const cv
   const double scale = 1 << shift;
   cv::circle(frame, cv::Point(static_cast<int>(std::lround(centre.x * scale)), static_cast<int>(std::lround(centre.y * scale))),
              static_cast<int>(std::lround(radius * scale)), colour, cv::FILLED, cv::LINE_AA, shift);
-}
-
-/// The lab-like camera of the tests: 640×480, fx 800, fy 805, off-centre principal
-/// point, barrel distortion, looking down at about 38° on the chute base (z = 0)
-/// from the camera side (−y).
-inline Camera obliqueCamera(double k1 = -0.1, double k2 = 0.0) {
-  Camera c;
-  c.fx = 800.0;
-  c.fy = 805.0;
-  c.cx = 322.3;
-  c.cy = 236.8;
-  c.k1 = k1;
-  c.k2 = k2;
-  c.frameRate = kFrameRate;
-  c.lookAt(Vec3(0.05, -0.45, 0.35), Vec3(0.0, 0.0, 0.0), Vec3(0, 0, 1));
-  return c;
 }
 
 /// A flat checkerboard on z = 0: inner_cols × inner_rows inner corners, squares of

@@ -15,9 +15,4 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 /// The polygon is split into a fan of triangles around vertex 0.
 Vec3 closestPointOnConvexPolygon(const Vec3& p, std::span<const Vec3> vertices);
 
-/// Signed distance of p from the plane through `point` with unit `normal`.
-inline double signedDistanceToPlane(const Vec3& p, const Vec3& point, const Vec3& normal) {
-  return (p - point).dot(normal);
-}
-
 }  // namespace rocklab::geometry
