@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -57,6 +58,42 @@ class StageTimer {
   double& seconds_;
   std::chrono::steady_clock::time_point start_;
 };
+
+/// Where a ball touches its partner (a ball or a wall): the one definition for
+/// the contact pass, the energy, the network check and the relaxation.
+struct ContactPoint {
+  Vec3 normal = Vec3::UnitZ();  // unit, from the ball towards its partner
+  double overlap = 0.0;         // m, geometric, before any relaxation offset
+  Vec3 point = Vec3::Zero();    // m, the middle of the overlap (the torque arms' end)
+};
+
+/// Ball i at xi (radius ri) against ball j; false when they are apart.
+[[gnu::always_inline]] inline bool ballBallTouch(const Vec3& xi, const Vec3& xj, double ri, double rj,
+                                                 ContactPoint& g) {
+  const Vec3 d = xj - xi;
+  const double rsum = ri + rj;
+  const double dist2 = d.squaredNorm();
+  if (dist2 >= rsum * rsum) return false;
+  const double dist = std::sqrt(dist2);
+  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
+  g.overlap = rsum - dist;
+  g.point = xi + g.normal * (ri - 0.5 * g.overlap);
+  return true;
+}
+
+/// A ball against an active wall; false when apart or the wall is not there.
+[[gnu::always_inline]] inline bool ballWallTouch(const detail::WallRuntime& runtime, const Wall& wall,
+                                                 const Vec3& xi, double ri, ContactPoint& g) {
+  detail::WallContact wc;
+  if (!runtime.active || !runtime.contact(wall, xi, ri, wc)) return false;
+  g.normal = wc.normal;
+  g.overlap = wc.overlap;
+  g.point = xi + g.normal * (ri - 0.5 * g.overlap);
+  return true;
+}
+
+/// Effective radius of two balls (Eq 2-24).
+inline double effectiveRadius(double ri, double rj) { return 2.0 * ri * rj / (ri + rj); }
 
 /// What this step has to do besides stepping (decided once, before the forces).
 struct StepPlan {
@@ -158,6 +195,19 @@ struct World::Impl {
   int teamSize() const {
     const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
     return std::max(1, std::min(threads, useful));
+  }
+  const detail::PairProps& pairProps(std::size_t i, std::size_t j) const {
+    return ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
+  }
+  const detail::PairProps& wallProps(std::size_t i, std::size_t wall) const {
+    return ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wall].material)];
+  }
+  /// The overlap the contact law sees while initial overlaps relax (Model::relaxation).
+  double pairOverlap(const ContactPoint& g, std::uint32_t k) const {
+    return relax.active() ? g.overlap - relax.factor * relax.pair[k] : g.overlap;
+  }
+  double wallOverlap(const ContactPoint& g, std::uint32_t c) const {
+    return relax.active() ? g.overlap - relax.factor * relax.wall[c] : g.overlap;
   }
   double& stageSeconds(Stage s) { return stats.stage_seconds[static_cast<std::size_t>(s)]; }
 

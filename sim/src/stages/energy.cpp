@@ -28,23 +28,18 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
     for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
       if (!history.pair_touch[k]) continue;
       const std::uint32_t j = nb.pairs.partner[k];
-      const double rsum = p.radius[i] + p.radius[j];
-      double overlap = rsum - (p.position[j] - p.position[i]).norm();
-      if (relax.active()) overlap -= relax.factor * relax.pair[k];
-      const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm +
-                                         static_cast<std::size_t>(p.material[j])];
-      e.elastic += detail::elasticEnergy<Law>(props, overlap, 2.0 * p.radius[i] * p.radius[j] / rsum,
-                                              history.pair_shear[k]);
+      ContactPoint touch;
+      if (!ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch)) continue;
+      e.elastic += detail::elasticEnergy<Law>(pairProps(i, j), pairOverlap(touch, k),
+                                              effectiveRadius(p.radius[i], p.radius[j]), history.pair_shear[k]);
     }
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
       if (!history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
-      detail::WallContact wc;
-      if (!walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc)) continue;
-      const PairProps& props = ball_wall[static_cast<std::size_t>(p.material[i]) * nm +
-                                         static_cast<std::size_t>(model.walls[wk].material)];
-      const double overlap = wc.overlap - (relax.active() ? relax.factor * relax.wall[c] : 0.0);
-      e.elastic += detail::elasticEnergy<Law>(props, overlap, p.radius[i], history.wall_shear[c]);
+      ContactPoint touch;
+      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
+      e.elastic += detail::elasticEnergy<Law>(wallProps(i, wk), wallOverlap(touch, c), p.radius[i],
+                                              history.wall_shear[c]);
     }
   }
   return e;

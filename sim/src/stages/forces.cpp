@@ -29,37 +29,33 @@ template <class Law>
                                       Vec3& tj, StepChecks& c) {
   const std::uint32_t j = nb.pairs.partner[k];
   const Vec3 xi = p.position[i];
-  const Vec3 d = p.position[j] - xi;
   const double ri = p.radius[i], rj = p.radius[j];
-  const double rsum = ri + rj;
-  const double dist2 = d.squaredNorm();
-  if (dist2 >= rsum * rsum) {
+  ContactPoint touch;
+  if (!ballBallTouch(xi, p.position[j], ri, rj, touch)) {
     history.pair_touch[k] = 0;
     history.pair_shear[k].setZero();
     if (relax.active()) relax.pair[k] = 0.0;  // separated: a new touch gets the full force
     return false;
   }
-  const double dist = std::sqrt(dist2);
   detail::ContactGeometry g;
-  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
-  g.overlap = rsum - dist;
-  const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);  // contact point: middle of the overlap
+  g.normal = touch.normal;
+  g.overlap = touch.overlap;
   if (relax.active()) {
     // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
-    g.overlap -= relax.factor * relax.pair[k];
+    g.overlap = pairOverlap(touch, k);
     if (g.overlap <= 0) {
       history.pair_touch[k] = 0;
       history.pair_shear[k].setZero();
       return false;
     }
   }
+  const Vec3 cp = touch.point;
   const Vec3 ai = cp - xi, aj = cp - p.position[j];
   g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
-  g.r_tilde = 2.0 * ri * rj / rsum;  // Eq 2-24
+  g.r_tilde = effectiveRadius(ri, rj);  // Eq 2-24
   const double mi = p.mass[i], mj = p.mass[j];
   g.damping_mass = detail::dampingMass(model.contact.damping_mass, mi, mj);
-  const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
-  const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, history.pair_shear[k]);
+  const detail::ContactResult res = detail::evaluateContact<Law>(pairProps(i, j), model.contact, g, dt, history.pair_shear[k]);
   fi = res.force;
   ti = ai.cross(res.force);
   fj = -res.force;
@@ -78,19 +74,19 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
   for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
     const std::uint32_t wk = nb.wall_index[w];
     const detail::WallRuntime& wr = walls[wk];
-    detail::WallContact wc;
-    if (!wr.active || !wr.contact(model.walls[wk], xi, ri, wc)) {
+    ContactPoint touch;
+    if (!ballWallTouch(wr, model.walls[wk], xi, ri, touch)) {
       history.wall_touch[w] = 0;
       history.wall_shear[w].setZero();
       if (relax.active()) relax.wall[w] = 0.0;
       continue;
     }
     detail::ContactGeometry g;
-    g.normal = wc.normal;
-    g.overlap = wc.overlap;
-    const Vec3 cp = xi + g.normal * (ri - 0.5 * g.overlap);
+    g.normal = touch.normal;
+    g.overlap = touch.overlap;
+    const Vec3 cp = touch.point;
     if (relax.active()) {
-      g.overlap -= relax.factor * relax.wall[w];
+      g.overlap = wallOverlap(touch, w);
       if (g.overlap <= 0) {
         history.wall_touch[w] = 0;
         history.wall_shear[w].setZero();
@@ -102,9 +98,8 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
     g.rel_velocity = v_wall - (p.velocity[i] + p.omega[i].cross(ai));
     g.r_tilde = ri;            // mirror-image ball (ref §4.2)
     g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)
-    const PairProps& props =
-        ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wk].material)];
-    const detail::ContactResult res = detail::evaluateContact<Law>(props, model.contact, g, dt, history.wall_shear[w]);
+    const detail::ContactResult res =
+        detail::evaluateContact<Law>(wallProps(i, wk), model.contact, g, dt, history.wall_shear[w]);
     f += res.force;
     t += ai.cross(res.force);
     history.wall_touch[w] = 1;

@@ -69,28 +69,23 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
       if (!history.pair_touch[q]) continue;
       const std::uint32_t j = nb.pairs.partner[q];
       if (body_of[i] == body_of[j]) continue;  // members of one clump
-      const Vec3 d = p.position[j] - p.position[i];
-      const double dist = d.norm(), rj = p.radius[j];
-      const Vec3 normal = dist > 0 ? Vec3(d / dist) : Vec3(Vec3::UnitZ());
-      double overlap = ri + rj - dist;
-      const Vec3 cp = p.position[i] + normal * (ri - 0.5 * overlap);
-      if (relax.active()) overlap -= relax.factor * relax.pair[q];
+      ContactPoint touch;
+      if (!ballBallTouch(p.position[i], p.position[j], ri, p.radius[j], touch)) continue;
+      const double overlap = pairOverlap(touch, q);
       if (overlap <= 0) continue;
-      const PairProps& props = ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
       const double md = detail::dampingMass(cm.damping_mass, p.mass[i], p.mass[j]);
-      add(i, body_of[j], normal, cp, centre(j), overlap, 2.0 * ri * rj / (ri + rj), md, props, history.pair_shear[q]);
+      add(i, body_of[j], touch.normal, touch.point, centre(j), overlap, effectiveRadius(ri, p.radius[j]), md,
+          pairProps(i, j), history.pair_shear[q]);
     }
     for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
       if (!history.wall_touch[w]) continue;
       const std::uint32_t wk = nb.wall_index[w];
-      detail::WallContact wc;
-      if (!walls[wk].active || !walls[wk].contact(model.walls[wk], p.position[i], ri, wc)) continue;
-      const Vec3 cp = p.position[i] + wc.normal * (ri - 0.5 * wc.overlap);
-      const double overlap = wc.overlap - (relax.active() ? relax.factor * relax.wall[w] : 0.0);
+      ContactPoint touch;
+      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], ri, touch)) continue;
+      const double overlap = wallOverlap(touch, w);
       if (overlap <= 0) continue;
-      const PairProps& props =
-          ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wk].material)];
-      add(i, -1, wc.normal, cp, cp, overlap, ri, p.mass[i], props, history.wall_shear[w]);
+      add(i, -1, touch.normal, touch.point, touch.point, overlap, ri, p.mass[i], wallProps(i, wk),
+          history.wall_shear[w]);
     }
   }
   // Springs of the force contributions (bonds): checked like contacts.

@@ -15,18 +15,17 @@ void World::Impl::startRelaxation() {
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
       const std::uint32_t j = nb.pairs.partner[k];
-      const double overlap = p.radius[i] + p.radius[j] - (p.position[j] - p.position[i]).norm();
-      if (overlap > 0) {
-        relax.pair[k] = overlap;
+      ContactPoint touch;
+      if (ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch) && touch.overlap > 0) {
+        relax.pair[k] = touch.overlap;
         any = true;
       }
     }
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
       const std::uint32_t wk = nb.wall_index[c];
-      detail::WallContact wc;
-      if (walls[wk].active && walls[wk].contact(model.walls[wk], p.position[i], p.radius[i], wc) &&
-          wc.overlap > 0) {
-        relax.wall[c] = wc.overlap;
+      ContactPoint touch;
+      if (ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch) && touch.overlap > 0) {
+        relax.wall[c] = touch.overlap;
         any = true;
       }
     }
