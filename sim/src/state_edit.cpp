@@ -39,15 +39,9 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
     keep[i] = !remove[i];
     if (keep[i]) new_index[i] = next++;
   }
-  compact(p.position, keep);
-  compact(p.velocity, keep);
-  compact(p.omega, keep);
-  compact(p.radius, keep);
-  compact(p.inv_mass, keep);
-  compact(p.inv_inertia, keep);
-  compact(p.material, keep);
-  compact(p.mass, keep);
-  compact(p.id, keep);
+#define ROCKLAB_COMPACT(type, name, unit, meaning) compact(p.name, keep);
+  ROCKLAB_BALL_FIELDS(ROCKLAB_COMPACT)
+#undef ROCKLAB_COMPACT
   if (k.size() > 0) {
     std::vector<std::int32_t> new_clump(k.size(), -1);
     std::int32_t next_clump = 0;
@@ -69,13 +63,9 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
     k.member_begin = std::move(begin);
     k.member_ball = std::move(ball);
     k.member_offset = std::move(offset);
-    compact(k.position, keep_clump);
-    compact(k.velocity, keep_clump);
-    compact(k.angular_momentum, keep_clump);
-    compact(k.orientation, keep_clump);
-    compact(k.mass, keep_clump);
-    compact(k.inertia, keep_clump);
-    compact(k.id, keep_clump);
+#define ROCKLAB_COMPACT(type, name, unit, meaning) compact(k.name, keep_clump);
+    ROCKLAB_CLUMP_FIELDS(ROCKLAB_COMPACT)
+#undef ROCKLAB_COMPACT
     if (k.size() == 0) {
       p.clump.clear();
       k = ClumpState{};

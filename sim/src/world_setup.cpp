@@ -100,15 +100,9 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vec
   std::size_t members = 0;
   for (const ClumpSpec& c : clumps) members += c.members.size();
   const std::size_t n = spheres.size() + members;
-  p.position.resize(n);
-  p.velocity.resize(n);
-  p.omega.resize(n);
-  p.radius.resize(n);
-  p.inv_mass.resize(n);
-  p.inv_inertia.resize(n);
-  p.material.resize(n);
-  p.mass.resize(n);
-  p.id.resize(n);
+#define ROCKLAB_RESIZE(type, name, unit, meaning) p.name.resize(n);
+  ROCKLAB_BALL_FIELDS(ROCKLAB_RESIZE)
+#undef ROCKLAB_RESIZE
   for (std::size_t i = 0; i < spheres.size(); ++i) {
     const SphereSpec& s = spheres[i];
     const double r = s.radius;

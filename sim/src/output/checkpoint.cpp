@@ -52,14 +52,9 @@ std::string describe(const H5::Exception& e) {
 std::string inconsistency(const WorldState& state) {
   const ParticleState& p = state.particles;
   const std::size_t n = p.size();
-  const std::pair<const char*, std::size_t> sizes[] = {{"velocity", p.velocity.size()},
-                                                       {"omega", p.omega.size()},
-                                                       {"radius", p.radius.size()},
-                                                       {"inv_mass", p.inv_mass.size()},
-                                                       {"inv_inertia", p.inv_inertia.size()},
-                                                       {"material", p.material.size()},
-                                                       {"mass", p.mass.size()},
-                                                       {"id", p.id.size()}};
+#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, p.name.size()},
+  const std::pair<const char*, std::size_t> sizes[] = {ROCKLAB_BALL_FIELDS(ROCKLAB_SIZE)};
+#undef ROCKLAB_SIZE
   for (const auto& [name, size] : sizes) {
     if (size != n) {
       return "inconsistent array sizes: particles/" + std::string(name) + " has " +
@@ -68,12 +63,9 @@ std::string inconsistency(const WorldState& state) {
   }
   const ClumpState& k = p.clumps;
   const std::size_t nc = k.size();
-  const std::pair<const char*, std::size_t> clump_sizes[] = {{"velocity", k.velocity.size()},
-                                                             {"angular_momentum", k.angular_momentum.size()},
-                                                             {"orientation", k.orientation.size()},
-                                                             {"mass", k.mass.size()},
-                                                             {"inertia", k.inertia.size()},
-                                                             {"id", k.id.size()}};
+#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, k.name.size()},
+  const std::pair<const char*, std::size_t> clump_sizes[] = {ROCKLAB_CLUMP_FIELDS(ROCKLAB_SIZE)};
+#undef ROCKLAB_SIZE
   for (const auto& [name, size] : clump_sizes) {
     if (size != nc) {
       return "inconsistent array sizes: clumps/" + std::string(name) + " has " + std::to_string(size) +
@@ -129,29 +121,19 @@ void writeHistory(const H5::Group& root, const HistoryLayout<History>& layout,
 
 void writeParticles(const H5::Group& root, const ParticleState& p) {
   const H5::Group group = root.createGroup("particles");
-  writeArray(group, "position", p.position, "m");
-  writeArray(group, "velocity", p.velocity, "m/s");
-  writeArray(group, "omega", p.omega, "rad/s");
-  writeArray(group, "radius", p.radius, "m");
-  writeArray(group, "inv_mass", p.inv_mass, "1/kg");
-  writeArray(group, "inv_inertia", p.inv_inertia, "1/(kg m^2)");
-  writeArray(group, "mass", p.mass, "kg");
-  writeArray(group, "material", p.material, "");
-  writeArray(group, "id", p.id, "");
+#define ROCKLAB_WRITE(type, name, unit, meaning) writeArray(group, #name, p.name, unit);
+  ROCKLAB_BALL_FIELDS(ROCKLAB_WRITE)
+#undef ROCKLAB_WRITE
   if (p.clumps.size() == 0) return;
   const ClumpState& k = p.clumps;
   writeArray(group, "clump", p.clump, "");
   const H5::Group clumps = root.createGroup("clumps");
-  writeArray(clumps, "position", k.position, "m");
-  writeArray(clumps, "velocity", k.velocity, "m/s");
-  writeArray(clumps, "angular_momentum", k.angular_momentum, "kg m^2/s");
-  writeArray(clumps, "orientation", k.orientation, "");
-  writeArray(clumps, "mass", k.mass, "kg");
-  writeArray(clumps, "inertia", k.inertia, "kg m^2");
+#define ROCKLAB_WRITE(type, name, unit, meaning) writeArray(clumps, #name, k.name, unit);
+  ROCKLAB_CLUMP_FIELDS(ROCKLAB_WRITE)
+#undef ROCKLAB_WRITE
   writeArray(clumps, "member_begin", k.member_begin, "");
   writeArray(clumps, "member_ball", k.member_ball, "");
   writeArray(clumps, "member_offset", k.member_offset, "m");
-  writeArray(clumps, "id", k.id, "");
 }
 
 void writeFile(const std::filesystem::path& path, const WorldState& state,
@@ -301,28 +283,18 @@ std::vector<History> readHistory(const Reader& in, const HistoryLayout<History>&
 
 ParticleState readParticles(const Reader& in) {
   ParticleState p;
-  p.position = in.array<Vec3>("/particles/position");
-  p.velocity = in.array<Vec3>("/particles/velocity");
-  p.omega = in.array<Vec3>("/particles/omega");
-  p.radius = in.array<double>("/particles/radius");
-  p.inv_mass = in.array<double>("/particles/inv_mass");
-  p.inv_inertia = in.array<double>("/particles/inv_inertia");
-  p.mass = in.array<double>("/particles/mass");
-  p.material = in.array<std::int32_t>("/particles/material");
-  p.id = in.array<std::uint64_t>("/particles/id");
+#define ROCKLAB_READ(type, name, unit, meaning) p.name = in.array<type>("/particles/" #name);
+  ROCKLAB_BALL_FIELDS(ROCKLAB_READ)
+#undef ROCKLAB_READ
   if (!in.has("/clumps")) return p;  // a sphere-only run
   p.clump = in.array<std::int32_t>("/particles/clump");
   ClumpState& k = p.clumps;
-  k.position = in.array<Vec3>("/clumps/position");
-  k.velocity = in.array<Vec3>("/clumps/velocity");
-  k.angular_momentum = in.array<Vec3>("/clumps/angular_momentum");
-  k.orientation = in.array<Quat>("/clumps/orientation");
-  k.mass = in.array<double>("/clumps/mass");
-  k.inertia = in.array<Vec3>("/clumps/inertia");
+#define ROCKLAB_READ(type, name, unit, meaning) k.name = in.array<type>("/clumps/" #name);
+  ROCKLAB_CLUMP_FIELDS(ROCKLAB_READ)
+#undef ROCKLAB_READ
   k.member_begin = in.array<std::uint32_t>("/clumps/member_begin");
   k.member_ball = in.array<std::uint32_t>("/clumps/member_ball");
   k.member_offset = in.array<Vec3>("/clumps/member_offset");
-  k.id = in.array<std::uint64_t>("/clumps/id");
   return p;
 }
 
