@@ -22,11 +22,11 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "experiment.h"
-#include "camera_calibration.h"
-#include "camera_recorder.h"
-#include "marker_tracking.h"
-#include "plot.h"
+#include "drivers/experiment.h"
+#include "camera/camera_calibration.h"
+#include "camera/camera_recorder.h"
+#include "analysis/marker_tracking.h"
+#include "analysis/plot.h"
 #include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
 

@@ -7,7 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "rocklab/experiments/render_run.h"
+#include "camera/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/shape.h"
