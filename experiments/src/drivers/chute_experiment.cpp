@@ -333,6 +333,13 @@ class ChuteExperiment final : public Experiment {
     return true;
   }
 
+  /// experiment.measure_distance as the plots print it, e.g. "100 mm".
+  std::string measureDistanceText() const {
+    std::ostringstream text;
+    text << e_.measure_distance * 1e3 << " mm";
+    return text.str();
+  }
+
   ExperimentSettings e_;
   double g_;
   Phase phase_ = Phase::Start;
@@ -430,7 +437,7 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
     s["rms_error_pct"] = 100.0 * std::sqrt(sum2_rel / compared);
     s["max_error_pct"] = 100.0 * max_rel;
     PlotSpec plot;
-    plot.title = "tracked (images only) against DEM truth, marker velocity over 100 mm";
+    plot.title = "tracked (images only) against DEM truth, marker velocity over " + measureDistanceText();
     plot.x_label = "truth velocity (m/s)";
     plot.y_label = "tracked velocity (m/s)";
     double lo = *std::min_element(points.x.begin(), points.x.end()), hi = *std::max_element(points.x.begin(), points.x.end());
@@ -546,7 +553,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
     writePlot(prof, out_dir / "velocity_profile.png");
     // The column profile: DEM truth and, when the camera's frames were tracked, the tracker's.
     PlotSpec columns;
-    columns.title = "column profile: mean marker velocity over 100 mm";
+    columns.title = "column profile: mean marker velocity over " + measureDistanceText();
     columns.x_label = "column distance from the gate (mm)";
     columns.y_label = "mean velocity (m/s)";
     PlotSeries truth{"DEM truth", {}, {}, PlotSeries::Style::LinePoints};
