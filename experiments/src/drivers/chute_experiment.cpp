@@ -166,9 +166,33 @@ class ChuteExperiment final : public Experiment {
     bodies_ = indexBodies(world->particles());
     removed_by_top_ = bodies_total_ - bodies_.size();
     bodies_total_ = bodies_.size();
+    calibrateTrackingCamera();
     chooseMarkers(world->particles());
     tilt_end_step_ = world->stepCount() + e_.tilt_steps;
     phase_ = Phase::Tilt;
+  }
+
+  /// Calibrates the tracked camera from checkerboard photos on the camera-side wall
+  /// (exact camera with calibration_photos = 0) and gives the tracker the marker size.
+  void calibrateTrackingCamera() {
+    // The lab calibrates its camera on the camera-side wall (y = 0, seen from -y)
+    // and knows how big its markers are and that they lie against that wall:
+    // their centres one (equivalent) radius behind it.
+    if (!tracking_) return;
+    try {
+      if (e_.calibration_photos > 0) {
+        const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
+                                                    Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
+        tracking_->setCamera(cal.camera);
+        calibration_report_ = cal.report;
+      }
+      tracking_->setMarkers(marker_radius_, marker_radius_);
+    } catch (const std::exception& e) {
+      // No calibrated camera, no tracking: the run goes on for the DEM truth and
+      // results.json says why nothing was tracked.
+      tracking_error_ = std::string("camera calibration failed: ") + e.what();
+      tracking_.reset();
+    }
   }
 
   /// The bodies nearest the lab marker positions, each taken once (column 1 first,
@@ -189,25 +213,6 @@ class ChuteExperiment final : public Experiment {
       const double gap = p.position[i].y() - p.radius[i];
       const auto [it, fresh] = wall_gap.emplace(id, gap);
       if (!fresh) it->second = std::min(it->second, gap);
-    }
-    // The lab calibrates its camera on the camera-side wall (y = 0, seen from -y)
-    // and knows how big its markers are and that they lie against that wall:
-    // their centres one (equivalent) radius behind it.
-    if (tracking_) {
-      try {
-        if (e_.calibration_photos > 0) {
-          const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
-                                                      Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
-          tracking_->setCamera(cal.camera);
-          calibration_report_ = cal.report;
-        }
-        tracking_->setMarkers(marker_radius_, marker_radius_);
-      } catch (const std::exception& e) {
-        // No calibrated camera, no tracking: the run goes on for the DEM truth and
-        // results.json says why nothing was tracked.
-        tracking_error_ = std::string("camera calibration failed: ") + e.what();
-        tracking_.reset();
-      }
     }
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
