@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "camera_calibration.h"
+#include "camera/camera_calibration.h"
 #include "rocklab/render/renderer.h"
 #include "rocklab/experiments/scene.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "heap_analysis.h"
+#include "analysis/heap_analysis.h"
 #include "rocklab/geometry/packing.h"
 
 using namespace rocklab::experiments;

@@ -7,7 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "plot.h"
+#include "analysis/plot.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;

@@ -1,4 +1,4 @@
-#include "frame_builder.h"
+#include "camera/frame_builder.h"
 
 #include "rocklab/sim/wall_motion.h"
 

@@ -14,9 +14,9 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "atomic_file.h"
-#include "camera_recorder.h"
-#include "experiment.h"
+#include "common/atomic_file.h"
+#include "camera/camera_recorder.h"
+#include "drivers/experiment.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/output/run_file.h"
 #include "rocklab/sim/output/vtk_series.h"

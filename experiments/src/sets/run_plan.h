@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "run_set.h"
+#include "sets/run_set.h"
 
 namespace rocklab::experiments::detail {
 

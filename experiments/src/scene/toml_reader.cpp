@@ -1,4 +1,4 @@
-#include "toml_reader.h"
+#include "scene/toml_reader.h"
 
 #include <charconv>
 #include <sstream>

@@ -5,11 +5,11 @@
 #include <numbers>
 #include <ostream>
 
-#include "camera_calibration.h"
-#include "camera_recorder.h"
-#include "experiment.h"
-#include "heap_analysis.h"
-#include "plot.h"
+#include "camera/camera_calibration.h"
+#include "camera/camera_recorder.h"
+#include "drivers/experiment.h"
+#include "analysis/heap_analysis.h"
+#include "analysis/plot.h"
 #include "rocklab/render/image_io.h"
 #include "rocklab/track/plane.h"
 

@@ -1,4 +1,4 @@
-#include "marker_tracking.h"
+#include "analysis/marker_tracking.h"
 
 #include <algorithm>
 #include <chrono>

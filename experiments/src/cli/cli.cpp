@@ -7,7 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "rocklab/experiments/render_run.h"
+#include "camera/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/shape.h"
@@ -89,7 +89,7 @@ int runCli(int argc, const char* const* argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "rocklab 0.1.0");
 
-  std::string scene_arg, checkpoint_arg, out_dir;
+  std::string scene_arg, checkpoint_arg, run_file_arg, out_dir;
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false;
@@ -117,7 +117,7 @@ int runCli(int argc, const char* const* argv) {
   app.add_subcommand("list", "List the built-in scenes and studies");
   std::string camera_file;
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
-  render->add_option("run", checkpoint_arg, "run.h5 written by an earlier run")->required();
+  render->add_option("run", run_file_arg, "run.h5 written by an earlier run")->required();
   render->add_option("--camera", camera_file, "TOML file with [[cameras]] tables (default: the scene's cameras)");
   render->add_option("--out", out_dir, "Output directory (default: the run file's folder)");
   std::vector<std::string> vary, metrics;
@@ -228,7 +228,7 @@ int runCli(int argc, const char* const* argv) {
     shape_options.preview = !no_preview;
     return runShape(shape_options, std::cerr);
   }
-  if (app.got_subcommand("render")) return renderRun({checkpoint_arg, camera_file, out_dir}, std::cerr);
+  if (app.got_subcommand("render")) return renderRun({run_file_arg, camera_file, out_dir}, std::cerr);
   if (app.got_subcommand("study")) {
     std::signal(SIGINT, onSigint);
     try {

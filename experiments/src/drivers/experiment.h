@@ -59,7 +59,7 @@ struct BodyRef {
 
 /// Every body of a world by its stable id (sphere ids and clump ids share one space).
 std::unordered_map<std::uint64_t, BodyRef> indexBodies(const sim::ParticleState& p);
-/// Centre of mass, velocity (at t - dt/2) and mass of a body.
+/// Centre of mass and mass of a body.
 geometry::Vec3 bodyPosition(const sim::ParticleState& p, const BodyRef& b);
 double bodyMass(const sim::ParticleState& p, const BodyRef& b);
 /// Largest ball speed (members included, so spin counts too), m/s.

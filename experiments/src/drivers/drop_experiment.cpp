@@ -8,7 +8,7 @@
 #include <cmath>
 #include <ostream>
 
-#include "experiment.h"
+#include "drivers/experiment.h"
 #include "rocklab/sim/timestep.h"
 
 namespace rocklab::experiments {

@@ -1,4 +1,4 @@
-#include "run_set.h"
+#include "sets/run_set.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace rocklab::experiments::detail {
 

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "run_plan.h"
+#include "sets/run_plan.h"
 
 namespace rocklab::experiments::detail {
 

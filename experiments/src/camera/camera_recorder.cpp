@@ -1,4 +1,4 @@
-#include "camera_recorder.h"
+#include "camera/camera_recorder.h"
 
 #include <cmath>
 #include <cstdio>

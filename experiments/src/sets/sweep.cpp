@@ -10,11 +10,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "atomic_file.h"
-#include "plot.h"
-#include "run_plan.h"
-#include "run_set.h"
-#include "study_report.h"
+#include "common/atomic_file.h"
+#include "analysis/plot.h"
+#include "sets/run_plan.h"
+#include "sets/run_set.h"
+#include "sets/study_report.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 

@@ -10,7 +10,7 @@
 #include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/mesh_import.h"
 #include "rocklab/geometry/packing.h"
-#include "toml_reader.h"
+#include "scene/toml_reader.h"
 
 #ifndef ROCKLAB_ASSET_DIR
 #define ROCKLAB_ASSET_DIR "assets"

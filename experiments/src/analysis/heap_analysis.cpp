@@ -1,4 +1,4 @@
-#include "heap_analysis.h"
+#include "analysis/heap_analysis.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "experiment.h"
+#include "drivers/experiment.h"
 
 #include <cmath>
 #include <numbers>

@@ -1,4 +1,4 @@
-#include "plot.h"
+#include "analysis/plot.h"
 
 #include <algorithm>
 #include <array>

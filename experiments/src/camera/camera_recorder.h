@@ -11,7 +11,7 @@
 #include <ostream>
 #include <unordered_set>
 
-#include "frame_builder.h"
+#include "camera/frame_builder.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/render/movie.h"
 #include "rocklab/render/renderer.h"

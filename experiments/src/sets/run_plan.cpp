@@ -1,4 +1,4 @@
-#include "run_plan.h"
+#include "sets/run_plan.h"
 
 #include <spawn.h>
 #include <sys/wait.h>
@@ -17,7 +17,7 @@
 #include <cerrno>
 #include <thread>
 
-#include "atomic_file.h"
+#include "common/atomic_file.h"
 
 extern char** environ;
 

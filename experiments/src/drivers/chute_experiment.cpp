@@ -22,11 +22,11 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "experiment.h"
-#include "camera_calibration.h"
-#include "camera_recorder.h"
-#include "marker_tracking.h"
-#include "plot.h"
+#include "drivers/experiment.h"
+#include "camera/camera_calibration.h"
+#include "camera/camera_recorder.h"
+#include "analysis/marker_tracking.h"
+#include "analysis/plot.h"
 #include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
 
@@ -166,9 +166,33 @@ class ChuteExperiment final : public Experiment {
     bodies_ = indexBodies(world->particles());
     removed_by_top_ = bodies_total_ - bodies_.size();
     bodies_total_ = bodies_.size();
+    calibrateTrackingCamera();
     chooseMarkers(world->particles());
     tilt_end_step_ = world->stepCount() + e_.tilt_steps;
     phase_ = Phase::Tilt;
+  }
+
+  /// Calibrates the tracked camera from checkerboard photos on the camera-side wall
+  /// (exact camera with calibration_photos = 0) and gives the tracker the marker size.
+  void calibrateTrackingCamera() {
+    // The lab calibrates its camera on the camera-side wall (y = 0, seen from -y)
+    // and knows how big its markers are and that they lie against that wall:
+    // their centres one (equivalent) radius behind it.
+    if (!tracking_) return;
+    try {
+      if (e_.calibration_photos > 0) {
+        const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
+                                                    Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
+        tracking_->setCamera(cal.camera);
+        calibration_report_ = cal.report;
+      }
+      tracking_->setMarkers(marker_radius_, marker_radius_);
+    } catch (const std::exception& e) {
+      // No calibrated camera, no tracking: the run goes on for the DEM truth and
+      // results.json says why nothing was tracked.
+      tracking_error_ = std::string("camera calibration failed: ") + e.what();
+      tracking_.reset();
+    }
   }
 
   /// The bodies nearest the lab marker positions, each taken once (column 1 first,
@@ -189,25 +213,6 @@ class ChuteExperiment final : public Experiment {
       const double gap = p.position[i].y() - p.radius[i];
       const auto [it, fresh] = wall_gap.emplace(id, gap);
       if (!fresh) it->second = std::min(it->second, gap);
-    }
-    // The lab calibrates its camera on the camera-side wall (y = 0, seen from -y)
-    // and knows how big its markers are and that they lie against that wall:
-    // their centres one (equivalent) radius behind it.
-    if (tracking_) {
-      try {
-        if (e_.calibration_photos > 0) {
-          const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
-                                                      Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
-          tracking_->setCamera(cal.camera);
-          calibration_report_ = cal.report;
-        }
-        tracking_->setMarkers(marker_radius_, marker_radius_);
-      } catch (const std::exception& e) {
-        // No calibrated camera, no tracking: the run goes on for the DEM truth and
-        // results.json says why nothing was tracked.
-        tracking_error_ = std::string("camera calibration failed: ") + e.what();
-        tracking_.reset();
-      }
     }
     std::vector<std::uint64_t> taken;
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
@@ -333,6 +338,13 @@ class ChuteExperiment final : public Experiment {
     return true;
   }
 
+  /// experiment.measure_distance as the plots print it, e.g. "100 mm".
+  std::string measureDistanceText() const {
+    std::ostringstream text;
+    text << e_.measure_distance * 1e3 << " mm";
+    return text.str();
+  }
+
   ExperimentSettings e_;
   double g_;
   Phase phase_ = Phase::Start;
@@ -430,7 +442,7 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
     s["rms_error_pct"] = 100.0 * std::sqrt(sum2_rel / compared);
     s["max_error_pct"] = 100.0 * max_rel;
     PlotSpec plot;
-    plot.title = "tracked (images only) against DEM truth, marker velocity over 100 mm";
+    plot.title = "tracked (images only) against DEM truth, marker velocity over " + measureDistanceText();
     plot.x_label = "truth velocity (m/s)";
     plot.y_label = "tracked velocity (m/s)";
     double lo = *std::min_element(points.x.begin(), points.x.end()), hi = *std::max_element(points.x.begin(), points.x.end());
@@ -546,7 +558,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
     writePlot(prof, out_dir / "velocity_profile.png");
     // The column profile: DEM truth and, when the camera's frames were tracked, the tracker's.
     PlotSpec columns;
-    columns.title = "column profile: mean marker velocity over 100 mm";
+    columns.title = "column profile: mean marker velocity over " + measureDistanceText();
     columns.x_label = "column distance from the gate (mm)";
     columns.y_label = "mean velocity (m/s)";
     PlotSeries truth{"DEM truth", {}, {}, PlotSeries::Style::LinePoints};

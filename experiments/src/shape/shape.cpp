@@ -11,8 +11,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "atomic_file.h"
-#include "plot.h"
+#include "common/atomic_file.h"
+#include "analysis/plot.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/geometry/mesh_check.h"

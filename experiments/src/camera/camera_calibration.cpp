@@ -1,4 +1,4 @@
-#include "camera_calibration.h"
+#include "camera/camera_calibration.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,11 +1,11 @@
-#include "rocklab/experiments/render_run.h"
+#include "camera/render_run.h"
 
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <unordered_set>
 
-#include "camera_recorder.h"
+#include "camera/camera_recorder.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/sim/output/run_file.h"
