@@ -16,7 +16,7 @@
 # friction 0.37, tangential history, no damping), dt = 1e-6 s, skin 2 mm and step count.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-rocklab="$root/build/app/rocklab"
+rocklab="${ROCKLAB_BIN:-$root/build/app/rocklab}"  # ROCKLAB_BIN: another build (old against new)
 [ -x "$rocklab" ] || { echo "build rocklab first: bash scripts/setup.sh" >&2; exit 2; }
 which_scenes=${1:-all}
 sizes=${2:-full}

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -243,6 +244,14 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   double network_ratio = 0.0;    // largest network step ratio over every World of the run
   // Network checks summed over the Worlds an experiment builds (a new one starts at 0).
   std::uint64_t checks_before = 0, checks_seen = 0;
+  // Seconds per engine stage, summed the same way over the Worlds of a run.
+  std::array<double, sim::kStageCount> stages_before{}, stages_seen{};
+  const sim::World* world_seen = nullptr;
+  auto stageTotal = [](const std::array<double, sim::kStageCount>& a) {
+    double sum = 0;
+    for (double x : a) sum += x;
+    return sum;
+  };
   try {
     while (world->stepCount() < end_step) {
       if (g_stop) {
@@ -266,6 +275,11 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
       if (world->stats().network_checks < checks_seen) checks_before += checks_seen;  // a new World (phase)
       checks_seen = world->stats().network_checks;
       network_ratio = std::max(network_ratio, world->stats().network_step_ratio);
+      const auto& stages_now = world->stats().stage_seconds;
+      if (world.get() != world_seen || stageTotal(stages_now) < stageTotal(stages_seen))  // a new World (phase)
+        for (std::size_t s = 0; s < sim::kStageCount; ++s) stages_before[s] += stages_seen[s];
+      stages_seen = stages_now;
+      world_seen = world.get();
       if (checkpoint_every && world->stepCount() % checkpoint_every == 0) writeCheckpoint();
       progress.update(world->stepCount(), experiment ? experiment->progress() : "");
       if (experiment_over) break;
@@ -344,6 +358,11 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
                       {"stepping", stepping},
                       {"output", output_seconds},
                       {"total", seconds(t_start, Clock::now())}};
+  // Wall time of each stage of World::step (sim/world.h), over every phase.
+  nlohmann::json stage_seconds = nlohmann::json::object();
+  for (std::size_t k = 0; k < sim::kStageCount; ++k)
+    stage_seconds[sim::stageName(static_cast<sim::Stage>(k))] = stages_before[k] + stages_seen[k];
+  r["stage_seconds"] = stage_seconds;
   r["particle_steps_per_s"] = stepping > 0 ? static_cast<double>(ball_steps) / stepping : 0.0;  // balls, members included
   r["neighbour_rebuilds"] = world->stats().neighbour_rebuilds;
   r["pairs_in_list"] = world->stats().pairs_in_list;
