@@ -9,6 +9,7 @@
 #include <ostream>
 
 #include "drivers/experiment.h"
+#include "drivers/registry.h"
 #include "rocklab/sim/timestep.h"
 
 namespace rocklab::experiments {
@@ -79,5 +80,9 @@ class DropExperiment final : public Experiment {
 }  // namespace
 
 std::unique_ptr<Experiment> makeDropExperiment(const Scene& scene) { return std::make_unique<DropExperiment>(scene); }
+
+
+/// The drop test has no keys of its own (experiments.md §a).
+void readDropSettings(TableReader& /*table*/, const SettingsContext& /*context*/, ExperimentSettings& /*settings*/) {}
 
 }  // namespace rocklab::experiments

@@ -6,18 +6,6 @@
 
 namespace rocklab::experiments {
 
-std::unique_ptr<Experiment> makeDropExperiment(const Scene& scene);
-std::unique_ptr<Experiment> makeHeapExperiment(const Scene& scene);
-std::unique_ptr<Experiment> makeChuteExperiment(const Scene& scene);
-
-std::unique_ptr<Experiment> makeExperiment(const Scene& scene) {
-  const std::string& type = scene.experiment.type;
-  if (type == "drop") return makeDropExperiment(scene);
-  if (type == "heap") return makeHeapExperiment(scene);
-  if (type == "chute") return makeChuteExperiment(scene);
-  return nullptr;
-}
-
 std::unordered_map<std::uint64_t, BodyRef> indexBodies(const sim::ParticleState& p) {
   std::unordered_map<std::uint64_t, BodyRef> bodies;
   for (std::size_t i = 0; i < p.size(); ++i)

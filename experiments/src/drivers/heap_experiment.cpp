@@ -8,6 +8,7 @@
 #include "camera/camera_calibration.h"
 #include "camera/camera_recorder.h"
 #include "drivers/experiment.h"
+#include "drivers/registry.h"
 #include "analysis/heap_analysis.h"
 #include "analysis/plot.h"
 #include "rocklab/render/image_io.h"
@@ -195,5 +196,13 @@ class HeapExperiment final : public Experiment {
 }  // namespace
 
 std::unique_ptr<Experiment> makeHeapExperiment(const Scene& scene) { return std::make_unique<HeapExperiment>(scene); }
+
+
+/// [experiment] keys of type "heap" (experiments.md §b).
+void readHeapSettings(TableReader& t, const SettingsContext& /*context*/, ExperimentSettings& e) {
+  readSettleSettings(t, e);
+  e.base_z = t.number("base_z", e.base_z);
+  e.bin_width = t.number("bin_width", e.bin_width, Range::positive());
+}
 
 }  // namespace rocklab::experiments

@@ -10,6 +10,7 @@
 #include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/mesh_import.h"
 #include "rocklab/geometry/packing.h"
+#include "drivers/registry.h"
 #include "scene/toml_reader.h"
 
 #ifndef ROCKLAB_ASSET_DIR
@@ -447,61 +448,16 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
 }
 
 /// Names of the walls, for messages.
-std::vector<std::string> wallNames(const sim::Model& model) {
-  std::vector<std::string> names;
-  for (const auto& w : model.walls) names.push_back(w.name);
-  return names;
-}
-
 void readExperiment(TableReader& root, const sim::Model& model, const std::vector<CameraSettings>& cameras,
                     ExperimentSettings& e) {
   auto t = root.table("experiment");
   if (!t) return;
-  e.type = t->requiredString("type", {"drop", "heap", "chute"});
-  const Range positive = Range::positive();
-  e.check_interval = t->number("check_interval", e.check_interval, positive);
-  if (e.type == "heap" || e.type == "chute") {
-    e.settle_speed = t->number("settle_speed", e.settle_speed, positive);
-    e.settle_min_time = t->number("settle_min_time", e.settle_min_time, Range::nonNegative());
-    e.settle_max_time = t->number("settle_max_time", e.settle_max_time, positive);
-    e.calibration_photos = static_cast<int>(t->integer("calibration_photos", e.calibration_photos, Range::closed(0, 11)));
-    if (e.calibration_photos > 0 && e.calibration_photos < 3)
-      t->fail("calibration_photos", "needs 0 (exact camera) or 3 to 11 photos (got " + std::to_string(e.calibration_photos) + ")");
-  }
-  if (e.type == "heap") {
-    e.base_z = t->number("base_z", e.base_z);
-    e.bin_width = t->number("bin_width", e.bin_width, positive);
-  }
-  if (e.type == "chute") {
-    const auto names = wallNames(model);
-    auto wallKey = [&](const std::string& key, const std::string& fallback) {
-      return t->string(key, fallback, names);
-    };
-    e.length = t->number("length", e.length, positive);
-    e.inclination_deg = t->number("inclination_deg", e.inclination_deg, Range::closed(0, 90));
-    e.deposit_inclination_deg = t->number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
-    e.rotate_gravity = t->string("gravity_tilt", "rotate", {"rotate", "add"}) == "rotate";
-    if (!e.rotate_gravity && (e.inclination_deg >= 90 || e.deposit_inclination_deg >= 90))
-      t->fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
-    e.gate_wall = wallKey("gate_wall", e.gate_wall);
-    if (t->has("top_wall")) e.top_wall = wallKey("top_wall", "");
-    e.temporary_walls = t->stringList("temporary_walls", names);
-    e.tilt_steps = static_cast<std::uint64_t>(t->integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
-    e.marker_columns = t->numberList("marker_columns", Range::nonNegative());
-    e.marker_heights = t->numberList("marker_heights", Range::nonNegative());
-    e.marker_height_fractions = t->numberList("marker_height_fractions", Range::closed(0, 1));
-    if (!e.marker_heights.empty() && !e.marker_height_fractions.empty())
-      t->fail("marker_height_fractions", "give marker_heights (m) or marker_height_fractions, not both");
-    e.marker_y = t->number("marker_y", e.marker_y, Range::nonNegative());
-    e.measure_distance = t->number("measure_distance", e.measure_distance, positive);
-    e.remove_beyond = t->number("remove_beyond", e.remove_beyond, positive);
-    e.jam_time = t->number("jam_time", e.jam_time, positive);
-    e.track = t->boolean("track", e.track);
-    std::vector<std::string> camera_names;
-    for (const auto& c : cameras) camera_names.push_back(c.name);
-    e.track_camera = t->string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
-    if (!e.track) e.track_camera.clear();
-  }
+  std::vector<std::string> types;
+  for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
+  e.type = t->requiredString("type", types);
+  e.check_interval = t->number("check_interval", e.check_interval, Range::positive());
+  // The driver reads and checks the keys of its type (drivers/registry.cpp).
+  findExperimentDriver(e.type)->read_settings(*t, SettingsContext{model, cameras}, e);
   t->finish();
 }
 
