@@ -24,6 +24,7 @@
 
 #include "drivers/experiment.h"
 #include "drivers/registry.h"
+#include "drivers/settle.h"
 #include "camera/camera_calibration.h"
 #include "camera/camera_recorder.h"
 #include "analysis/marker_tracking.h"
@@ -56,7 +57,7 @@ nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 class ChuteExperiment final : public Experiment {
  public:
-  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()) {
+  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()), settle_(scene.experiment) {
     for (const CameraSettings& c : scene.cameras)
       if (c.name == e_.track_camera) {
         tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);
@@ -90,12 +91,8 @@ class ChuteExperiment final : public Experiment {
       return true;
     }
     if (step % every_ != 0) return true;
-    const double t = world->time();
     if (phase_ == Phase::Deposit) {
-      speed_ = maxBallSpeed(world->particles());
-      if (t < e_.settle_min_time) return true;
-      settled_ = speed_ < e_.settle_speed;
-      if (!settled_ && t < e_.settle_max_time) return true;
+      if (!settle_.over(*world)) return true;
       endDeposit(world, ctx);
       return true;
     }
@@ -107,7 +104,7 @@ class ChuteExperiment final : public Experiment {
     s << std::setprecision(3);
     switch (phase_) {
       case Phase::Start:
-      case Phase::Deposit: s << "deposit, max speed " << speed_ << " m/s"; break;
+      case Phase::Deposit: s << "deposit, max speed " << settle_.maxSpeed() << " m/s"; break;
       case Phase::Tilt: s << "tilt"; break;
       case Phase::Flow: s << "flow, " << (bodies_total_ - discharged_count_) << " bodies in the chute"; break;
       case Phase::Done: s << "done"; break;
@@ -352,8 +349,9 @@ class ChuteExperiment final : public Experiment {
   std::uint64_t every_ = 1, tilt_end_step_ = 0;
   std::unordered_map<std::uint64_t, BodyRef> bodies_;
   std::size_t bodies_total_ = 0, removed_by_top_ = 0;
-  bool settled_ = false, jammed_ = false;
-  double speed_ = 0, deposit_time_ = std::numeric_limits<double>::quiet_NaN();
+  SettleDetector settle_;
+  bool jammed_ = false;
+  double deposit_time_ = std::numeric_limits<double>::quiet_NaN();
   double gate_time_ = std::numeric_limits<double>::quiet_NaN(), last_discharge_ = 0;
   double clearance_time_ = std::numeric_limits<double>::quiet_NaN(), bed_height_ = 0;
   std::vector<Marker> markers_;
@@ -511,9 +509,9 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   r["chute"] = {{"inclination_deg", e_.inclination_deg},
                 {"gravity_tilt", e_.rotate_gravity ? "rotate" : "add"},
                 {"deposit_inclination_deg", e_.deposit_inclination_deg},
-                {"deposit_settled", settled_},
+                {"deposit_settled", settle_.settled()},
                 {"deposit_end_s", orNull(deposit_time_)},
-                {"deposit_max_speed_mps", speed_},
+                {"deposit_max_speed_mps", settle_.maxSpeed()},
                 {"bed_height_m", bed_height_},
                 {"bodies_removed_by_top_plate", removed_by_top_},
                 {"bodies", bodies_total_},
@@ -588,7 +586,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   }
 
   log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit "
-      << (settled_ ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed " << bed_height_ * 1e3
+      << (settle_.settled() ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed " << bed_height_ * 1e3
       << " mm, " << bodies_total_ << " bodies";
   if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";

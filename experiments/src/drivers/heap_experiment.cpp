@@ -9,6 +9,7 @@
 #include "camera/camera_recorder.h"
 #include "drivers/experiment.h"
 #include "drivers/registry.h"
+#include "drivers/settle.h"
 #include "analysis/heap_analysis.h"
 #include "analysis/plot.h"
 #include "rocklab/render/image_io.h"
@@ -20,7 +21,7 @@ namespace {
 
 class HeapExperiment final : public Experiment {
  public:
-  explicit HeapExperiment(const Scene& scene) : e_(scene.experiment) {
+  explicit HeapExperiment(const Scene& scene) : e_(scene.experiment), settle_(scene.experiment) {
     if (!scene.cameras.empty()) camera_ = scene.cameras.front();
   }
 
@@ -32,10 +33,7 @@ class HeapExperiment final : public Experiment {
     const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
     if (world->stepCount() % every != 0) return true;
     const double t = world->time();
-    speed_ = maxBallSpeed(world->particles());
-    if (t < e_.settle_min_time) return true;
-    settled_ = speed_ < e_.settle_speed;
-    if (!settled_ && t < e_.settle_max_time) return true;
+    if (!settle_.over(*world)) return true;
     settle_time_ = t;
     const auto& p = world->particles();
     balls_.clear();
@@ -44,14 +42,14 @@ class HeapExperiment final : public Experiment {
   }
 
   std::string progress() const override {
-    return "max speed " + std::to_string(speed_).substr(0, 6) + " m/s (settled below " +
+    return "max speed " + std::to_string(settle_.maxSpeed()).substr(0, 6) + " m/s (settled below " +
            std::to_string(e_.settle_speed).substr(0, 6) + ")";
   }
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override {
     nlohmann::json h;
-    h["settled"] = settled_;
-    h["max_speed_mps"] = speed_;
+    h["settled"] = settle_.settled();
+    h["max_speed_mps"] = settle_.maxSpeed();
     if (balls_.empty()) {
       r["angle_of_repose_deg"] = nullptr;
       h["note"] = "the run ended before the heap was measured (raise scene.end_time)";
@@ -71,7 +69,7 @@ class HeapExperiment final : public Experiment {
       h["method"] = a.method;
       log << "heap: angle of repose " << a.mean_deg << " deg (flanks";
       for (double f : a.flank_deg) log << " " << f;
-      log << "), height " << a.height_m << " m" << (settled_ ? "" : " — NOT settled (settle_max_time reached)") << "\n";
+      log << "), height " << a.height_m << " m" << (settle_.settled() ? "" : " — NOT settled (settle_max_time reached)") << "\n";
     } catch (const std::exception& ex) {
       r["angle_of_repose_deg"] = nullptr;
       h["note"] = std::string("no heap to measure: ") + ex.what();
@@ -188,8 +186,8 @@ class HeapExperiment final : public Experiment {
   ExperimentSettings e_;
   CameraSettings camera_;  // the first camera: it takes the photograph
   cv::Mat photo_;
-  bool settled_ = false;
-  double speed_ = 0, settle_time_ = 0;
+  SettleDetector settle_;
+  double settle_time_ = 0;
   std::vector<geometry::Sphere> balls_;
 };
 

@@ -1,0 +1,34 @@
+#pragma once
+// The settle detector every depositing experiment shares (heap; the chute's
+// deposition; the Zwick and crusher feeds next): a deposit is settled when no
+// ball is faster than settle_speed, looked at on the driver's sample steps and
+// not before settle_min_time; at settle_max_time it ends unsettled, and the
+// report says so instead of hiding it.
+#include "drivers/experiment.h"
+
+namespace rocklab::experiments {
+
+class SettleDetector {
+ public:
+  explicit SettleDetector(const ExperimentSettings& e)
+      : speed_limit_(e.settle_speed), min_time_(e.settle_min_time), max_time_(e.settle_max_time) {}
+
+  /// Call on a sample step: true once the deposit is over (settled, or out of time).
+  bool over(const sim::World& world) {
+    speed_ = maxBallSpeed(world.particles());
+    const double t = world.time();
+    if (t < min_time_) return false;
+    settled_ = speed_ < speed_limit_;
+    return settled_ || t >= max_time_;
+  }
+  bool settled() const { return settled_; }
+  /// m/s, the largest ball speed at the last sample.
+  double maxSpeed() const { return speed_; }
+
+ private:
+  double speed_limit_, min_time_, max_time_;  // m/s, s, s
+  bool settled_ = false;
+  double speed_ = 0.0;
+};
+
+}  // namespace rocklab::experiments
