@@ -6,6 +6,7 @@
 
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/sweep.h"
+#include "drivers/experiment_settings.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
@@ -140,11 +141,11 @@ TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
   const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/";
   const Scene base = loadScene(dir + "chute-30-clumps.toml");
   const Scene steep = loadScene(dir + "chute-33-clumps.toml");
-  CHECK(steep.experiment.inclination_deg == 33.0);
+  CHECK(steep.experiment->inclination_deg == 33.0);
   CHECK(steep.run.name == "chute-33-clumps");
   CHECK(steep.clumps.size() == base.clumps.size());
   CHECK(steep.model.walls.size() == base.model.walls.size());
-  CHECK(steep.experiment.marker_columns == base.experiment.marker_columns);
+  CHECK(steep.experiment->marker_columns == base.experiment->marker_columns);
   const Scene spheres = loadScene(dir + "chute-30-spheres.toml");  // [[particles]] replaced whole
   CHECK(spheres.clumps.empty());
   CHECK(spheres.spheres.size() == 1680);

@@ -57,7 +57,7 @@ nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 class ChuteExperiment final : public Experiment {
  public:
-  explicit ChuteExperiment(const Scene& scene) : e_(scene.experiment), g_(scene.model.gravity.norm()), settle_(scene.experiment) {
+  explicit ChuteExperiment(const Scene& scene) : e_(*scene.experiment), g_(scene.model.gravity.norm()), settle_(*scene.experiment) {
     for (const CameraSettings& c : scene.cameras)
       if (c.name == e_.track_camera) {
         tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);

@@ -46,7 +46,7 @@ class Experiment {
   virtual void report(nlohmann::json& results, const std::filesystem::path& out_dir, std::ostream& log) = 0;
 };
 
-/// The driver for scene.experiment.type, or null for a plain run (drivers/registry.cpp).
+/// The driver for scene.experiment_type, or null for a plain run (drivers/registry.cpp).
 std::unique_ptr<Experiment> makeExperiment(const Scene& scene);
 
 // ---- helpers shared by the drivers

@@ -21,7 +21,7 @@ namespace {
 
 class HeapExperiment final : public Experiment {
  public:
-  explicit HeapExperiment(const Scene& scene) : e_(scene.experiment), settle_(scene.experiment) {
+  explicit HeapExperiment(const Scene& scene) : e_(*scene.experiment), settle_(*scene.experiment) {
     if (!scene.cameras.empty()) camera_ = scene.cameras.front();
   }
 

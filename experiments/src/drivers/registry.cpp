@@ -18,7 +18,7 @@ const ExperimentDriver* findExperimentDriver(const std::string& type) {
 }
 
 std::unique_ptr<Experiment> makeExperiment(const Scene& scene) {
-  const ExperimentDriver* driver = findExperimentDriver(scene.experiment.type);
+  const ExperimentDriver* driver = findExperimentDriver(scene.experiment_type);
   return driver ? driver->make(scene) : nullptr;
 }
 

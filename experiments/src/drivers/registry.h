@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drivers/experiment.h"
+#include "drivers/experiment_settings.h"
 #include "scene/toml_reader.h"
 
 namespace rocklab::experiments {

@@ -118,7 +118,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   }
   std::unique_ptr<Experiment> experiment = makeExperiment(scene);
   if (experiment && !options.restart.empty()) {
-    log << "error: " << scene.source.string() << ": experiment." << scene.experiment.type
+    log << "error: " << scene.source.string() << ": experiment." << scene.experiment_type
         << " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not saved); run the scene again\n";
     return kExitBadInput;
   }
@@ -154,7 +154,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); })) modules.push_back("walls:moving");
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
   if (world->particles().clumps.size() > 0) modules.push_back("clumps");
-  if (experiment) modules.push_back("experiment:" + scene.experiment.type);
+  if (experiment) modules.push_back("experiment:" + scene.experiment_type);
   if (!scene.cameras.empty()) modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");
   if (scene.run.hdf5) modules.push_back("output:hdf5");
   if (scene.run.vtk) modules.push_back("output:vtk");
@@ -396,7 +396,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     log << line.str();
   }
   if (experiment) {
-    r["experiment"] = scene.experiment.type;
+    r["experiment"] = scene.experiment_type;
     if (status == "completed" && !experiment_over) r["experiment_status"] = "time limit (scene.end_time) reached first";
     experiment->report(r, options.out_dir, log);
   }

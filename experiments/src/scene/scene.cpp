@@ -448,10 +448,13 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
 }
 
 /// Names of the walls, for messages.
-void readExperiment(TableReader& root, const sim::Model& model, const std::vector<CameraSettings>& cameras,
-                    ExperimentSettings& e) {
+/// The [experiment] table read by its type's driver; null without one (a plain run).
+std::shared_ptr<ExperimentSettings> readExperiment(TableReader& root, const sim::Model& model,
+                                                   const std::vector<CameraSettings>& cameras) {
   auto t = root.table("experiment");
-  if (!t) return;
+  if (!t) return nullptr;
+  auto settings = std::make_shared<ExperimentSettings>();
+  ExperimentSettings& e = *settings;
   std::vector<std::string> types;
   for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
   e.type = t->requiredString("type", types);
@@ -459,6 +462,7 @@ void readExperiment(TableReader& root, const sim::Model& model, const std::vecto
   // The driver reads and checks the keys of its type (drivers/registry.cpp).
   findExperimentDriver(e.type)->read_settings(*t, SettingsContext{model, cameras}, e);
   t->finish();
+  return settings;
 }
 
 Scene readScene(const toml::table& root_table, const std::filesystem::path& base_dir,
@@ -570,7 +574,10 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   readParticles(root, materials, model.materials, scene.run.seed, base_dir, scene);
 
   readCameras(root, scene.cameras);
-  readExperiment(root, model, scene.cameras, scene.experiment);
+  if (auto settings = readExperiment(root, model, scene.cameras)) {
+    scene.experiment_type = settings->type;
+    scene.experiment = std::move(settings);
+  }
 
   // [output]
   if (auto t = root.table("output")) {

@@ -27,7 +27,7 @@ using namespace detail;
 
 /// The figures a sweep reports when none are named: the experiment's headline.
 std::vector<std::string> defaultMetrics(const Scene& scene) {
-  const std::string& type = scene.experiment.type;
+  const std::string& type = scene.experiment_type;
   std::vector<std::string> m;
   if (type == "drop") m = {"restitution", "drop.contact_time_s"};
   if (type == "heap") m = {"angle_of_repose_deg", "heap.settled"};
