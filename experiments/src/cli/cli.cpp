@@ -83,131 +83,258 @@ int doList() {
 
 }  // namespace
 
+namespace {
+
+/// Everything the command line can set: CLI11 fills it, the commands read it.
+struct CliArgs {
+  std::string scene_arg, checkpoint_arg, run_file_arg, out_dir, camera_file, collect_dir;
+  std::vector<std::string> overrides;
+  int threads = 0;
+  bool quiet = false, skip_complete = false;
+  // sweep, calibrate, study
+  std::vector<std::string> vary, metrics;
+  std::string target, plan_dir, figure, reference;
+  int iterations = 8, jobs = -1, seeds = 0;
+  double tolerance = -1.0;
+  SweepOptions::Slurm slurm;
+  // shape
+  ShapeOptions shape_options;
+  bool no_preview = false;
+};
+
+void addRunOptions(CLI::App* c, CliArgs& a) {
+  c->add_option("--out", a.out_dir, "Output directory (default: out/<scene name>)");
+  c->add_option("--set", a.overrides, "Override a scene key, e.g. --set timestep.dt=1e-6 (TOML value)")
+      ->take_all();
+  c->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  c->add_flag("--quiet", a.quiet, "No progress line");
+}
+
+void addSetOptions(CLI::App* c, CliArgs& a) {
+  c->add_option("--jobs", a.jobs,
+                "Runs at once, each its own process of one thread (default: one per core); 0 = one after the "
+                "other in this process, each with --threads")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--plan", a.plan_dir,
+                "Write the run list (runs.txt), a Slurm array script and a README into DIR and run nothing; "
+                "`rocklab collect DIR` merges the runs afterwards");
+  c->add_option("--slurm-time", a.slurm.time, "Slurm time limit per run (with --plan)")->capture_default_str();
+  c->add_option("--slurm-mem", a.slurm.memory, "Slurm memory per run (with --plan)")->capture_default_str();
+  c->add_option("--slurm-partition", a.slurm.partition, "Slurm partition (with --plan; default: the cluster's)");
+}
+
+// What --out, --threads, --quiet and the set options ask of a sweep or study.
+void applySetOptions(const CliArgs& a, SweepOptions& so) {
+  if (!a.plan_dir.empty() && !a.out_dir.empty() && a.plan_dir != a.out_dir)
+    throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
+  so.out_dir = a.plan_dir.empty() ? a.out_dir : a.plan_dir;
+  so.plan_only = !a.plan_dir.empty();
+  so.jobs = a.jobs;
+  so.slurm = a.slurm;
+  so.threads = a.threads;
+  so.progress = !a.quiet;
+}
+
+void addSweepOptions(CLI::App* c, CliArgs& a) {
+  c->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
+  c->add_option("--vary", a.vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
+  addRunOptions(c, a);
+}
+
+/// Every subcommand and its options, bound to the fields of `a`.
+void addCommands(CLI::App& app, CliArgs& a) {
+  auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
+  run->add_option("scene", a.scene_arg, "Scene TOML file or built-in name (see `rocklab list`)")->required();
+  addRunOptions(run, a);
+  run->add_flag("--skip-complete", a.skip_complete,
+                "Do nothing when --out already holds a completed run (results.json status \"completed\")");
+  auto* demo = app.add_subcommand("demo", "Run the default demo scene end to end");
+  addRunOptions(demo, a);
+  auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
+  restart->add_option("checkpoint", a.checkpoint_arg, "checkpoint.h5 written by an earlier run")->required();
+  addRunOptions(restart, a);
+  auto* check = app.add_subcommand("check", "Validate a scene and print its time-step audit without running");
+  check->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
+  check->add_option("--set", a.overrides, "Override a scene key")->take_all();
+  app.add_subcommand("list", "List the built-in scenes and studies");
+  auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
+  render->add_option("run", a.run_file_arg, "run.h5 written by an earlier run")->required();
+  render->add_option("--camera", a.camera_file, "TOML file with [[cameras]] tables (default: the scene's cameras)");
+  render->add_option("--out", a.out_dir, "Output directory (default: the run file's folder)");
+  auto* sweep = app.add_subcommand("sweep", "Run a scene for every combination of --vary values; writes sweep.csv and sweep.png");
+  addSweepOptions(sweep, a);
+  sweep->add_option("--metric", a.metrics, "results.json figure to tabulate, dotted path (default: the experiment's)");
+  addSetOptions(sweep, a);
+  auto* calibrate = app.add_subcommand(
+      "calibrate", "Find the value of one key that gives a target figure (list: interpolate; lo:hi range: bisect)");
+  addSweepOptions(calibrate, a);
+  calibrate->add_option("--target", a.target, "metric=value, e.g. angle_of_repose_deg=26.03")->required();
+  calibrate->add_option("--iterations", a.iterations, "Bisection steps for a lo:hi range")->check(CLI::PositiveNumber);
+  auto* study = app.add_subcommand(
+      "study", "Error against run time: a figure for every --vary combination, against the finest or a lab value");
+  study->add_option("scene", a.scene_arg, "Scene file or name, or a study file / built-in study (assets/studies)")
+      ->required();
+  study->add_option("--vary", a.vary, "key=a,b,c from the cheapest to the finest value (replaces the study file's)");
+  study->add_option("--figure", a.figure, "results.json figure, dotted path (e.g. restitution, tracking.rms_error_pct)");
+  study->add_option("--reference", a.reference, "finest (default: the last variant) or a lab value");
+  study->add_option("--tolerance", a.tolerance, "error (%) the recommended variant may have (default 5)")
+      ->check(CLI::PositiveNumber);
+  study->add_option("--seeds", a.seeds,
+                    "runs per variant with seeds from the scene's up: mean, seed scatter and whether the errors "
+                    "exceed it (default: the study file's, else 1)")
+      ->check(CLI::PositiveNumber);
+  addRunOptions(study, a);
+  addSetOptions(study, a);
+  auto* collect = app.add_subcommand("collect", "Merge the finished runs of a sweep or study folder into its table, "
+                                                "plot and recommendation (failed and missing runs listed)");
+  collect->add_option("dir", a.collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
+
+  auto* shape = app.add_subcommand("shape", "Mesh (STL/PLY/OBJ) -> checked mass properties and a clump of spheres with its error");
+  shape->add_option("mesh", a.shape_options.mesh, "Mesh file (with --generate: the mesh file to write, .stl/.ply/.obj)")->required();
+  shape->add_option("--out", a.shape_options.out_dir, "Output directory (clump.txt, clump.toml, preview.png, results.json)")->required();
+  shape->add_option("--method", a.shape_options.method, "surface (tangent spheres grown from the surface) | medial (medial axis)");
+  shape->add_option("--spheres", a.shape_options.spheres, "Largest number of spheres");
+  shape->add_option("--tolerance", a.shape_options.tolerance, "Stop when the uncovered volume fraction is below this (0 = off)");
+  shape->add_option("--unit", a.shape_options.unit, "Unit of the file's coordinates: m | mm");
+  shape->add_option("--size", a.shape_options.size, "Scale to this size (m); see --size-kind");
+  shape->add_option("--size-kind", a.shape_options.size_kind, "equivalent (equal-volume sphere diameter) | sieve");
+  shape->add_option("--density", a.shape_options.density, "kg/m^3 (mass and inertia in clump.toml)");
+  shape->add_option("--min-radius", a.shape_options.min_radius, "Smallest member radius, fraction of the equivalent diameter");
+  shape->add_option("--touch", a.shape_options.touch, "Surface method: node tolerance, fraction of the equivalent diameter");
+  shape->add_option("--grid", a.shape_options.grid, "Inside-grid cells along the longest extent");
+  shape->add_option("--generate", a.shape_options.generate, "Make a seeded scan-like mesh first: pebble | crushed | flake");
+  shape->add_option("--seed", a.shape_options.seed, "Seed of --generate and of the surface samples");
+  shape->add_option("--sweep", a.shape_options.sweep, "Sphere counts for the error table, e.g. 1,2,4,8,16")->delimiter(',');
+  shape->add_flag("--pile", a.shape_options.pile, "With --sweep: time a settling pile of clumps for each count");
+  shape->add_option("--pile-clumps", a.shape_options.pile_clumps, "Clumps in the pile");
+  shape->add_option("--pile-time", a.shape_options.pile_time, "Simulated time of the pile (s)");
+  shape->add_flag("--no-preview", a.no_preview, "Do not render preview.png");
+}
+
+int studyCommand(const CliArgs& a) {
+  std::signal(SIGINT, onSigint);
+  try {
+    StudyOptions so;
+    if (const auto file = findStudyFile(a.scene_arg)) so = loadStudyFile(*file);
+    else so.runs.scene = a.scene_arg;
+    so.runs.overrides.insert(so.runs.overrides.end(), a.overrides.begin(), a.overrides.end());
+    if (!a.vary.empty()) so.runs.vary.clear();
+    for (const std::string& v : a.vary) so.runs.vary.push_back(parseVary(v));
+    if (!a.figure.empty()) so.figure = a.figure;
+    if (a.reference == "finest") so.reference.reset();
+    else if (!a.reference.empty()) {
+      std::size_t used = 0;
+      try {
+        so.reference = std::stod(a.reference, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != a.reference.size())
+        throw std::invalid_argument("--reference '" + a.reference + "': give finest or a number (a lab value)");
+    }
+    if (a.tolerance > 0) so.tolerance_pct = a.tolerance;
+    if (a.seeds > 0) so.seeds = a.seeds;
+    applySetOptions(a, so.runs);
+    return runStudy(so, std::cerr);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+}
+
+int sweepCommand(const CliArgs& a, bool calibrate) {
+  SweepOptions so;
+  so.scene = a.scene_arg;
+  so.overrides = a.overrides;
+  so.metrics = a.metrics;
+  so.out_dir = a.out_dir;
+  so.threads = a.threads;
+  so.progress = !a.quiet;
+  std::signal(SIGINT, onSigint);
+  try {
+    for (const std::string& v : a.vary) so.vary.push_back(parseVary(v));
+    if (!calibrate) {
+      applySetOptions(a, so);
+      return runSweep(so, std::cerr);
+    }
+    CalibrateOptions co;
+    co.sweep = so;
+    co.iterations = a.iterations;
+    const auto eq = a.target.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--target '" + a.target + "': expected metric=value");
+    co.target_metric = a.target.substr(0, eq);
+    std::size_t used = 0;
+    co.target = std::stod(a.target.substr(eq + 1), &used);
+    if (used != a.target.size() - eq - 1) throw std::invalid_argument("--target '" + a.target + "': value is not a number");
+    return runCalibrate(co, std::cerr);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+}
+
+/// run, demo, restart and check: one scene, loaded and checked, then run.
+int sceneCommand(const CliArgs& a, const std::string& command) {
+  Scene scene;
+  RunOptions options;
+  options.threads = a.threads;
+  options.progress = !a.quiet;
+  try {
+    if (command == "restart") {
+      // The checkpoint carries the scene text it was run with.
+      const sim::output::Checkpoint cp = sim::output::readCheckpoint(a.checkpoint_arg);
+      scene = loadSceneText(cp.scene_text, a.checkpoint_arg + ":/scene", a.overrides,
+                            std::filesystem::path(a.checkpoint_arg).parent_path());
+      options.restart = a.checkpoint_arg;
+    } else {
+      const std::string name = command == "demo" ? "demo" : a.scene_arg;
+      scene = loadScene(resolveScene(name), a.overrides);
+    }
+  } catch (const SceneError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const sim::output::CheckpointError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+
+  if (command == "check") {
+    try {
+      sim::World world(scene.model, scene.spheres, scene.clumps, 1);
+      std::cout << scene.source.string() << ": valid; " << scene.spheres.size() << " spheres, "
+                << scene.clumps.size() << " clumps, " << scene.model.walls.size() << " walls\n"
+                << world.timestepAudit().describe(scene.model.timestep) << "\n";
+      return kExitOk;
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "error: " << scene.source.string() << ": " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+
+  options.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(a.out_dir);
+  if (a.skip_complete) {
+    std::ifstream in(options.out_dir / "results.json");
+    const nlohmann::json r = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
+    if (r.is_object() && r.value("status", "") == "completed") {
+      std::cerr << "rocklab: " << (options.out_dir / "results.json").string() << " is complete; not run again\n";
+      return kExitOk;
+    }
+  }
+  std::signal(SIGINT, onSigint);
+  const int code = runScene(scene, options, std::cerr);
+  std::signal(SIGINT, SIG_DFL);
+  return code;
+}
+
+}  // namespace
+
 int runCli(int argc, const char* const* argv) {
   CLI::App app{"rocklab: DEM workbench for laboratory experiments on rock flow and breakage"};
   app.footer(kExamples);
   app.require_subcommand(1);
   app.set_version_flag("--version", "rocklab 0.1.0");
-
-  std::string scene_arg, checkpoint_arg, run_file_arg, out_dir;
-  std::vector<std::string> overrides;
-  int threads = 0;
-  bool quiet = false;
-  auto addRunOptions = [&](CLI::App* c) {
-    c->add_option("--out", out_dir, "Output directory (default: out/<scene name>)");
-    c->add_option("--set", overrides, "Override a scene key, e.g. --set timestep.dt=1e-6 (TOML value)")
-        ->take_all();
-    c->add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
-    c->add_flag("--quiet", quiet, "No progress line");
-  };
-  auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
-  run->add_option("scene", scene_arg, "Scene TOML file or built-in name (see `rocklab list`)")->required();
-  addRunOptions(run);
-  bool skip_complete = false;
-  run->add_flag("--skip-complete", skip_complete,
-                "Do nothing when --out already holds a completed run (results.json status \"completed\")");
-  auto* demo = app.add_subcommand("demo", "Run the default demo scene end to end");
-  addRunOptions(demo);
-  auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
-  restart->add_option("checkpoint", checkpoint_arg, "checkpoint.h5 written by an earlier run")->required();
-  addRunOptions(restart);
-  auto* check = app.add_subcommand("check", "Validate a scene and print its time-step audit without running");
-  check->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
-  check->add_option("--set", overrides, "Override a scene key")->take_all();
-  app.add_subcommand("list", "List the built-in scenes and studies");
-  std::string camera_file;
-  auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
-  render->add_option("run", run_file_arg, "run.h5 written by an earlier run")->required();
-  render->add_option("--camera", camera_file, "TOML file with [[cameras]] tables (default: the scene's cameras)");
-  render->add_option("--out", out_dir, "Output directory (default: the run file's folder)");
-  std::vector<std::string> vary, metrics;
-  std::string target;
-  int iterations = 8;
-  int jobs = -1;
-  std::string plan_dir;
-  SweepOptions::Slurm slurm;
-  auto addSetOptions = [&](CLI::App* c) {
-    c->add_option("--jobs", jobs,
-                  "Runs at once, each its own process of one thread (default: one per core); 0 = one after the "
-                  "other in this process, each with --threads")
-        ->check(CLI::NonNegativeNumber);
-    c->add_option("--plan", plan_dir,
-                  "Write the run list (runs.txt), a Slurm array script and a README into DIR and run nothing; "
-                  "`rocklab collect DIR` merges the runs afterwards");
-    c->add_option("--slurm-time", slurm.time, "Slurm time limit per run (with --plan)")->capture_default_str();
-    c->add_option("--slurm-mem", slurm.memory, "Slurm memory per run (with --plan)")->capture_default_str();
-    c->add_option("--slurm-partition", slurm.partition, "Slurm partition (with --plan; default: the cluster's)");
-  };
-  // What --out, --threads, --quiet and the set options above ask of a sweep or study.
-  auto applySetOptions = [&](SweepOptions& so) {
-    if (!plan_dir.empty() && !out_dir.empty() && plan_dir != out_dir)
-      throw std::invalid_argument("--plan DIR is the output folder: give --plan or --out, not both");
-    so.out_dir = plan_dir.empty() ? out_dir : plan_dir;
-    so.plan_only = !plan_dir.empty();
-    so.jobs = jobs;
-    so.slurm = slurm;
-    so.threads = threads;
-    so.progress = !quiet;
-  };
-  auto addSweepOptions = [&](CLI::App* c) {
-    c->add_option("scene", scene_arg, "Scene TOML file or built-in name")->required();
-    c->add_option("--vary", vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
-    addRunOptions(c);
-  };
-  auto* sweep = app.add_subcommand("sweep", "Run a scene for every combination of --vary values; writes sweep.csv and sweep.png");
-  addSweepOptions(sweep);
-  sweep->add_option("--metric", metrics, "results.json figure to tabulate, dotted path (default: the experiment's)");
-  addSetOptions(sweep);
-  auto* calibrate = app.add_subcommand(
-      "calibrate", "Find the value of one key that gives a target figure (list: interpolate; lo:hi range: bisect)");
-  addSweepOptions(calibrate);
-  calibrate->add_option("--target", target, "metric=value, e.g. angle_of_repose_deg=26.03")->required();
-  calibrate->add_option("--iterations", iterations, "Bisection steps for a lo:hi range")->check(CLI::PositiveNumber);
-  std::string figure, reference;
-  double tolerance = -1.0;
-  auto* study = app.add_subcommand(
-      "study", "Error against run time: a figure for every --vary combination, against the finest or a lab value");
-  study->add_option("scene", scene_arg, "Scene file or name, or a study file / built-in study (assets/studies)")
-      ->required();
-  study->add_option("--vary", vary, "key=a,b,c from the cheapest to the finest value (replaces the study file's)");
-  study->add_option("--figure", figure, "results.json figure, dotted path (e.g. restitution, tracking.rms_error_pct)");
-  study->add_option("--reference", reference, "finest (default: the last variant) or a lab value");
-  study->add_option("--tolerance", tolerance, "error (%) the recommended variant may have (default 5)")
-      ->check(CLI::PositiveNumber);
-  int seeds = 0;
-  study->add_option("--seeds", seeds,
-                    "runs per variant with seeds from the scene's up: mean, seed scatter and whether the errors "
-                    "exceed it (default: the study file's, else 1)")
-      ->check(CLI::PositiveNumber);
-  addRunOptions(study);
-  addSetOptions(study);
-  std::string collect_dir;
-  auto* collect = app.add_subcommand("collect", "Merge the finished runs of a sweep or study folder into its table, "
-                                                "plot and recommendation (failed and missing runs listed)");
-  collect->add_option("dir", collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
-
-  ShapeOptions shape_options;
-  bool no_preview = false;
-  auto* shape = app.add_subcommand("shape", "Mesh (STL/PLY/OBJ) -> checked mass properties and a clump of spheres with its error");
-  shape->add_option("mesh", shape_options.mesh, "Mesh file (with --generate: the mesh file to write, .stl/.ply/.obj)")->required();
-  shape->add_option("--out", shape_options.out_dir, "Output directory (clump.txt, clump.toml, preview.png, results.json)")->required();
-  shape->add_option("--method", shape_options.method, "surface (tangent spheres grown from the surface) | medial (medial axis)");
-  shape->add_option("--spheres", shape_options.spheres, "Largest number of spheres");
-  shape->add_option("--tolerance", shape_options.tolerance, "Stop when the uncovered volume fraction is below this (0 = off)");
-  shape->add_option("--unit", shape_options.unit, "Unit of the file's coordinates: m | mm");
-  shape->add_option("--size", shape_options.size, "Scale to this size (m); see --size-kind");
-  shape->add_option("--size-kind", shape_options.size_kind, "equivalent (equal-volume sphere diameter) | sieve");
-  shape->add_option("--density", shape_options.density, "kg/m^3 (mass and inertia in clump.toml)");
-  shape->add_option("--min-radius", shape_options.min_radius, "Smallest member radius, fraction of the equivalent diameter");
-  shape->add_option("--touch", shape_options.touch, "Surface method: node tolerance, fraction of the equivalent diameter");
-  shape->add_option("--grid", shape_options.grid, "Inside-grid cells along the longest extent");
-  shape->add_option("--generate", shape_options.generate, "Make a seeded scan-like mesh first: pebble | crushed | flake");
-  shape->add_option("--seed", shape_options.seed, "Seed of --generate and of the surface samples");
-  shape->add_option("--sweep", shape_options.sweep, "Sphere counts for the error table, e.g. 1,2,4,8,16")->delimiter(',');
-  shape->add_flag("--pile", shape_options.pile, "With --sweep: time a settling pile of clumps for each count");
-  shape->add_option("--pile-clumps", shape_options.pile_clumps, "Clumps in the pile");
-  shape->add_option("--pile-time", shape_options.pile_time, "Simulated time of the pile (s)");
-  shape->add_flag("--no-preview", no_preview, "Do not render preview.png");
+  CliArgs a;
+  addCommands(app, a);
 
   try {
     app.parse(argc, argv);
@@ -223,122 +350,19 @@ int runCli(int argc, const char* const* argv) {
   }
 
   if (app.got_subcommand("list")) return doList();
-  if (app.got_subcommand("collect")) return collectSet(collect_dir, std::cerr);
+  if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("shape")) {
-    shape_options.preview = !no_preview;
-    return runShape(shape_options, std::cerr);
+    a.shape_options.preview = !a.no_preview;
+    return runShape(a.shape_options, std::cerr);
   }
-  if (app.got_subcommand("render")) return renderRun({run_file_arg, camera_file, out_dir}, std::cerr);
-  if (app.got_subcommand("study")) {
-    std::signal(SIGINT, onSigint);
-    try {
-      StudyOptions so;
-      if (const auto file = findStudyFile(scene_arg)) so = loadStudyFile(*file);
-      else so.runs.scene = scene_arg;
-      so.runs.overrides.insert(so.runs.overrides.end(), overrides.begin(), overrides.end());
-      if (!vary.empty()) so.runs.vary.clear();
-      for (const std::string& v : vary) so.runs.vary.push_back(parseVary(v));
-      if (!figure.empty()) so.figure = figure;
-      if (reference == "finest") so.reference.reset();
-      else if (!reference.empty()) {
-        std::size_t used = 0;
-        try {
-          so.reference = std::stod(reference, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == 0 || used != reference.size())
-          throw std::invalid_argument("--reference '" + reference + "': give finest or a number (a lab value)");
-      }
-      if (tolerance > 0) so.tolerance_pct = tolerance;
-      if (seeds > 0) so.seeds = seeds;
-      applySetOptions(so.runs);
-      return runStudy(so, std::cerr);
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << "\n";
-      return kExitBadInput;
-    }
-  }
-  if (app.got_subcommand("sweep") || app.got_subcommand("calibrate")) {
-    SweepOptions so;
-    so.scene = scene_arg;
-    so.overrides = overrides;
-    so.metrics = metrics;
-    so.out_dir = out_dir;
-    so.threads = threads;
-    so.progress = !quiet;
-    std::signal(SIGINT, onSigint);
-    try {
-      for (const std::string& v : vary) so.vary.push_back(parseVary(v));
-      if (app.got_subcommand("sweep")) {
-        applySetOptions(so);
-        return runSweep(so, std::cerr);
-      }
-      CalibrateOptions co;
-      co.sweep = so;
-      co.iterations = iterations;
-      const auto eq = target.find('=');
-      if (eq == std::string::npos) throw std::invalid_argument("--target '" + target + "': expected metric=value");
-      co.target_metric = target.substr(0, eq);
-      std::size_t used = 0;
-      co.target = std::stod(target.substr(eq + 1), &used);
-      if (used != target.size() - eq - 1) throw std::invalid_argument("--target '" + target + "': value is not a number");
-      return runCalibrate(co, std::cerr);
-    } catch (const std::exception& e) {
-      std::cerr << "error: " << e.what() << "\n";
-      return kExitBadInput;
-    }
-  }
+  if (app.got_subcommand("render")) return renderRun({a.run_file_arg, a.camera_file, a.out_dir}, std::cerr);
+  if (app.got_subcommand("study")) return studyCommand(a);
+  if (app.got_subcommand("sweep") || app.got_subcommand("calibrate"))
+    return sweepCommand(a, app.got_subcommand("calibrate"));
 
-  Scene scene;
-  RunOptions options;
-  options.threads = threads;
-  options.progress = !quiet;
-  try {
-    if (app.got_subcommand("restart")) {
-      // The checkpoint carries the scene text it was run with.
-      const sim::output::Checkpoint cp = sim::output::readCheckpoint(checkpoint_arg);
-      scene = loadSceneText(cp.scene_text, checkpoint_arg + ":/scene", overrides,
-                            std::filesystem::path(checkpoint_arg).parent_path());
-      options.restart = checkpoint_arg;
-    } else {
-      const std::string name = app.got_subcommand("demo") ? "demo" : scene_arg;
-      scene = loadScene(resolveScene(name), overrides);
-    }
-  } catch (const SceneError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const sim::output::CheckpointError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitBadInput;
-  }
-
-  if (app.got_subcommand("check")) {
-    try {
-      sim::World world(scene.model, scene.spheres, scene.clumps, 1);
-      std::cout << scene.source.string() << ": valid; " << scene.spheres.size() << " spheres, "
-                << scene.clumps.size() << " clumps, " << scene.model.walls.size() << " walls\n"
-                << world.timestepAudit().describe(scene.model.timestep) << "\n";
-      return kExitOk;
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "error: " << scene.source.string() << ": " << e.what() << "\n";
-      return kExitBadInput;
-    }
-  }
-
-  options.out_dir = out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(out_dir);
-  if (skip_complete) {
-    std::ifstream in(options.out_dir / "results.json");
-    const nlohmann::json r = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
-    if (r.is_object() && r.value("status", "") == "completed") {
-      std::cerr << "rocklab: " << (options.out_dir / "results.json").string() << " is complete; not run again\n";
-      return kExitOk;
-    }
-  }
-  std::signal(SIGINT, onSigint);
-  const int code = runScene(scene, options, std::cerr);
-  std::signal(SIGINT, SIG_DFL);
-  return code;
+  for (const char* command : {"restart", "demo", "check"})
+    if (app.got_subcommand(command)) return sceneCommand(a, command);
+  return sceneCommand(a, "run");
 }
 
 }  // namespace rocklab::experiments
