@@ -42,7 +42,6 @@ struct ContactGeometry {
 
 struct ContactResult {
   Vec3 force;          // N on body A
-  double normal_elastic;  // N, K^n U^n (Eq 2-2), >= 0
 };
 
 struct LinearLaw {
@@ -112,7 +111,7 @@ template <class Law>
     ft = shear;
     if (cm.damping_shear > 0) ft += dashpot(cm.damping_shear, g.damping_mass, ks) * vt;
   }
-  return {ft - fn_total * n, fn_elastic};
+  return {ft - fn_total * n};
 }
 
 /// Elastic energy stored at a contact (normal + shear spring).

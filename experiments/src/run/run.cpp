@@ -87,6 +87,50 @@ class Progress {
   bool printed_ = false;
 };
 
+/// Active modules: what this scene constructs (and so pays for), for the log and results.json.
+std::vector<std::string> activeModules(const Scene& scene, const sim::World& world, bool has_experiment) {
+  const sim::Model& model = world.model();
+  std::vector<std::string> modules;
+  modules.push_back(model.contact.law == sim::ContactLaw::Linear ? "contact:linear" : "contact:hertz_mindlin");
+  if (model.contact.damping_normal > 0 || model.contact.damping_shear > 0) modules.push_back("damping:viscous");
+  if (model.contact.local_damping > 0) modules.push_back("damping:local");
+  const std::pair<sim::WallShape, const char*> shapes[] = {
+      {sim::WallShape::Plane, "walls:plane"}, {sim::WallShape::Polygon, "walls:polygon"}, {sim::WallShape::Mesh, "walls:mesh"}};
+  auto anyWall = [&model](auto predicate) { return std::any_of(model.walls.begin(), model.walls.end(), predicate); };
+  for (const auto& [shape, name] : shapes)
+    if (anyWall([shape = shape](const sim::Wall& w) { return w.shape == shape; })) modules.push_back(name);
+  if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); })) modules.push_back("walls:moving");
+  if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
+  if (world.particles().clumps.size() > 0) modules.push_back("clumps");
+  if (has_experiment) modules.push_back("experiment:" + scene.experiment_type);
+  if (!scene.cameras.empty()) modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");
+  if (scene.run.hdf5) modules.push_back("output:hdf5");
+  if (scene.run.vtk) modules.push_back("output:vtk");
+  if (scene.run.checkpoint) modules.push_back("output:checkpoint");
+  return modules;
+}
+
+/// The set-up lines of the log: scene, modules, clump shapes, time-step audit, steps.
+void logSetup(const Scene& scene, const sim::World& world, const RunOptions& options,
+              const std::vector<std::string>& modules, std::uint64_t total_steps, std::ostream& log) {
+  const sim::Model& model = world.model();
+  log << "rocklab: scene '" << scene.run.name << "'" << (options.restart.empty() ? "" : " (restart)") << ", "
+      << world.particles().size() << " balls (" << world.particles().clumps.size() << " clumps), "
+      << model.walls.size() << " walls, threads: "
+      << world.threads() << "\n";
+  log << "  modules: ";
+  for (std::size_t k = 0; k < modules.size(); ++k) log << (k ? ", " : "") << modules[k];
+  log << "\n";
+  for (const ClumpShapeReport& c : scene.clump_shapes)
+    log << "  clump shape of " << c.source << ": " << c.shape << ", " << c.members << " members, mass "
+        << c.mass * 1e3 << " g (" << c.distribution << " distribution), volume " << c.volume * 1e9
+        << " mm^3 (equivalent diameter " << c.equivalent_diameter * 1e3 << " mm); true union volume "
+        << c.union_volume * 1e9 << " +- " << c.union_volume_error * 1e9 << " mm^3\n";
+  log << world.timestepAudit().describe(model.timestep) << "\n";
+  log << "  steps: " << total_steps << " from t = " << world.time() << " s, output to " << options.out_dir.string()
+      << "\n";
+}
+
 }  // namespace
 
 void requestStop() { g_stop = true; }
@@ -140,41 +184,9 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
     return kExitBadInput;
   }
 
-  // Active modules: what this scene constructs (and so pays for).
   const sim::Model& model = world->model();
-  std::vector<std::string> modules;
-  modules.push_back(model.contact.law == sim::ContactLaw::Linear ? "contact:linear" : "contact:hertz_mindlin");
-  if (model.contact.damping_normal > 0 || model.contact.damping_shear > 0) modules.push_back("damping:viscous");
-  if (model.contact.local_damping > 0) modules.push_back("damping:local");
-  const std::pair<sim::WallShape, const char*> shapes[] = {
-      {sim::WallShape::Plane, "walls:plane"}, {sim::WallShape::Polygon, "walls:polygon"}, {sim::WallShape::Mesh, "walls:mesh"}};
-  auto anyWall = [&model](auto predicate) { return std::any_of(model.walls.begin(), model.walls.end(), predicate); };
-  for (const auto& [shape, name] : shapes)
-    if (anyWall([shape = shape](const sim::Wall& w) { return w.shape == shape; })) modules.push_back(name);
-  if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); })) modules.push_back("walls:moving");
-  if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
-  if (world->particles().clumps.size() > 0) modules.push_back("clumps");
-  if (experiment) modules.push_back("experiment:" + scene.experiment_type);
-  if (!scene.cameras.empty()) modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");
-  if (scene.run.hdf5) modules.push_back("output:hdf5");
-  if (scene.run.vtk) modules.push_back("output:vtk");
-  if (scene.run.checkpoint) modules.push_back("output:checkpoint");
-
-  log << "rocklab: scene '" << scene.run.name << "'" << (options.restart.empty() ? "" : " (restart)") << ", "
-      << world->particles().size() << " balls (" << world->particles().clumps.size() << " clumps), "
-      << model.walls.size() << " walls, threads: "
-      << world->threads() << "\n";
-  log << "  modules: ";
-  for (std::size_t k = 0; k < modules.size(); ++k) log << (k ? ", " : "") << modules[k];
-  log << "\n";
-  for (const ClumpShapeReport& c : scene.clump_shapes)
-    log << "  clump shape of " << c.source << ": " << c.shape << ", " << c.members << " members, mass "
-        << c.mass * 1e3 << " g (" << c.distribution << " distribution), volume " << c.volume * 1e9
-        << " mm^3 (equivalent diameter " << c.equivalent_diameter * 1e3 << " mm); true union volume "
-        << c.union_volume * 1e9 << " +- " << c.union_volume_error * 1e9 << " mm^3\n";
-  log << world->timestepAudit().describe(model.timestep) << "\n";
-  log << "  steps: " << total_steps << " from t = " << world->time() << " s, output to " << options.out_dir.string()
-      << "\n";
+  const std::vector<std::string> modules = activeModules(scene, *world, experiment != nullptr);
+  logSetup(scene, *world, options, modules, total_steps, log);
 
   // Cameras: the GL context is made here, only when the scene has a camera.
   std::vector<std::unique_ptr<CameraRecorder>> cameras;
