@@ -251,7 +251,6 @@ void World::Impl::buildPairProps() {
     }
 }
 
-
 /// Sets the members' positions, velocities and spins from their clump's state.
 void World::Impl::placeMembers(std::size_t c) {
   ClumpState& k = p.clumps;
@@ -265,6 +264,5 @@ void World::Impl::placeMembers(std::size_t c) {
     p.omega[i] = w;
   }
 }
-
 
 }  // namespace rocklab::sim

@@ -610,38 +610,37 @@ std::unique_ptr<Experiment> makeChuteExperiment(const Scene& scene) {
 
 
 /// [experiment] keys of type "chute" (experiments.md §c, §d).
-void readChuteSettings(TableReader& table, const SettingsContext& context, ExperimentSettings& e) {
-  TableReader* const t = &table;
-  readSettleSettings(table, e);
+void readChuteSettings(TableReader& t, const SettingsContext& context, ExperimentSettings& e) {
+  readSettleSettings(t, e);
   const Range positive = Range::positive();
   std::vector<std::string> names;
   for (const auto& w : context.model.walls) names.push_back(w.name);
   auto wallKey = [&](const std::string& key, const std::string& fallback) {
-    return t->string(key, fallback, names);
+    return t.string(key, fallback, names);
   };
-  e.length = t->number("length", e.length, positive);
-  e.inclination_deg = t->number("inclination_deg", e.inclination_deg, Range::closed(0, 90));
-  e.deposit_inclination_deg = t->number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
-  e.rotate_gravity = t->string("gravity_tilt", "rotate", {"rotate", "add"}) == "rotate";
+  e.length = t.number("length", e.length, positive);
+  e.inclination_deg = t.number("inclination_deg", e.inclination_deg, Range::closed(0, 90));
+  e.deposit_inclination_deg = t.number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
+  e.rotate_gravity = t.string("gravity_tilt", "rotate", {"rotate", "add"}) == "rotate";
   if (!e.rotate_gravity && (e.inclination_deg >= 90 || e.deposit_inclination_deg >= 90))
-    t->fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
+    t.fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
   e.gate_wall = wallKey("gate_wall", e.gate_wall);
-  if (t->has("top_wall")) e.top_wall = wallKey("top_wall", "");
-  e.temporary_walls = t->stringList("temporary_walls", names);
-  e.tilt_steps = static_cast<std::uint64_t>(t->integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
-  e.marker_columns = t->numberList("marker_columns", Range::nonNegative());
-  e.marker_heights = t->numberList("marker_heights", Range::nonNegative());
-  e.marker_height_fractions = t->numberList("marker_height_fractions", Range::closed(0, 1));
+  if (t.has("top_wall")) e.top_wall = wallKey("top_wall", "");
+  e.temporary_walls = t.stringList("temporary_walls", names);
+  e.tilt_steps = static_cast<std::uint64_t>(t.integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
+  e.marker_columns = t.numberList("marker_columns", Range::nonNegative());
+  e.marker_heights = t.numberList("marker_heights", Range::nonNegative());
+  e.marker_height_fractions = t.numberList("marker_height_fractions", Range::closed(0, 1));
   if (!e.marker_heights.empty() && !e.marker_height_fractions.empty())
-    t->fail("marker_height_fractions", "give marker_heights (m) or marker_height_fractions, not both");
-  e.marker_y = t->number("marker_y", e.marker_y, Range::nonNegative());
-  e.measure_distance = t->number("measure_distance", e.measure_distance, positive);
-  e.remove_beyond = t->number("remove_beyond", e.remove_beyond, positive);
-  e.jam_time = t->number("jam_time", e.jam_time, positive);
-  e.track = t->boolean("track", e.track);
+    t.fail("marker_height_fractions", "give marker_heights (m) or marker_height_fractions, not both");
+  e.marker_y = t.number("marker_y", e.marker_y, Range::nonNegative());
+  e.measure_distance = t.number("measure_distance", e.measure_distance, positive);
+  e.remove_beyond = t.number("remove_beyond", e.remove_beyond, positive);
+  e.jam_time = t.number("jam_time", e.jam_time, positive);
+  e.track = t.boolean("track", e.track);
   std::vector<std::string> camera_names;
   for (const auto& c : context.cameras) camera_names.push_back(c.name);
-  e.track_camera = t->string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
+  e.track_camera = t.string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
   if (!e.track) e.track_camera.clear();
 }
 

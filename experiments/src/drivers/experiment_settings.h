@@ -13,7 +13,6 @@ namespace rocklab::experiments {
 /// struct for all types; each type reads the keys it needs (reference:
 /// experiments.md §a drop, §b heap, §c chute, §d zoned chute).
 struct ExperimentSettings {
-  std::string type;  // "" (plain run), "drop", "heap", "chute"
   // Settling (heap; chute deposition): settled when no body is faster than
   // settle_speed, checked every check_interval, not before settle_min_time.
   double settle_speed = 0.02;      // m/s

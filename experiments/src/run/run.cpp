@@ -254,16 +254,12 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   bool experiment_over = false;
   std::uint64_t ball_steps = 0;  // balls stepped, summed over steps (bodies may be removed)
   double network_ratio = 0.0;    // largest network step ratio over every World of the run
-  // Network checks summed over the Worlds an experiment builds (a new one starts at 0).
+  // Network checks and seconds per engine stage, summed over the Worlds an
+  // experiment builds: a World's counters start at 0, and switchPhase makes the
+  // new World before the old one goes, so a new address is a new World.
   std::uint64_t checks_before = 0, checks_seen = 0;
-  // Seconds per engine stage, summed the same way over the Worlds of a run.
   std::array<double, sim::kStageCount> stages_before{}, stages_seen{};
   const sim::World* world_seen = nullptr;
-  auto stageTotal = [](const std::array<double, sim::kStageCount>& a) {
-    double sum = 0;
-    for (double x : a) sum += x;
-    return sum;
-  };
   try {
     while (world->stepCount() < end_step) {
       if (g_stop) {
@@ -284,14 +280,14 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
         world->step(observer);
       else
         world->step();
-      if (world->stats().network_checks < checks_seen) checks_before += checks_seen;  // a new World (phase)
-      checks_seen = world->stats().network_checks;
-      network_ratio = std::max(network_ratio, world->stats().network_step_ratio);
-      const auto& stages_now = world->stats().stage_seconds;
-      if (world.get() != world_seen || stageTotal(stages_now) < stageTotal(stages_seen))  // a new World (phase)
+      if (world.get() != world_seen) {  // a new World (phase)
+        checks_before += checks_seen;
         for (std::size_t s = 0; s < sim::kStageCount; ++s) stages_before[s] += stages_seen[s];
-      stages_seen = stages_now;
-      world_seen = world.get();
+        world_seen = world.get();
+      }
+      checks_seen = world->stats().network_checks;
+      stages_seen = world->stats().stage_seconds;
+      network_ratio = std::max(network_ratio, world->stats().network_step_ratio);
       if (checkpoint_every && world->stepCount() % checkpoint_every == 0) writeCheckpoint();
       progress.update(world->stepCount(), experiment ? experiment->progress() : "");
       if (experiment_over) break;

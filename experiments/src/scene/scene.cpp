@@ -447,22 +447,20 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
   }
 }
 
-/// Names of the walls, for messages.
-/// The [experiment] table read by its type's driver; null without one (a plain run).
-std::shared_ptr<ExperimentSettings> readExperiment(TableReader& root, const sim::Model& model,
-                                                   const std::vector<CameraSettings>& cameras) {
+/// The [experiment] table: its type, and its keys read and checked by that
+/// type's driver; nothing for a plain run.
+void readExperiment(TableReader& root, Scene& scene) {
   auto t = root.table("experiment");
-  if (!t) return nullptr;
-  auto settings = std::make_shared<ExperimentSettings>();
-  ExperimentSettings& e = *settings;
+  if (!t) return;
   std::vector<std::string> types;
   for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
-  e.type = t->requiredString("type", types);
-  e.check_interval = t->number("check_interval", e.check_interval, Range::positive());
+  scene.experiment_type = t->requiredString("type", types);
+  auto settings = std::make_shared<ExperimentSettings>();
+  settings->check_interval = t->number("check_interval", settings->check_interval, Range::positive());
   // The driver reads and checks the keys of its type (drivers/registry.cpp).
-  findExperimentDriver(e.type)->read_settings(*t, SettingsContext{model, cameras}, e);
+  findExperimentDriver(scene.experiment_type)->read_settings(*t, SettingsContext{scene.model, scene.cameras}, *settings);
   t->finish();
-  return settings;
+  scene.experiment = std::move(settings);
 }
 
 Scene readScene(const toml::table& root_table, const std::filesystem::path& base_dir,
@@ -574,10 +572,7 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   readParticles(root, materials, model.materials, scene.run.seed, base_dir, scene);
 
   readCameras(root, scene.cameras);
-  if (auto settings = readExperiment(root, model, scene.cameras)) {
-    scene.experiment_type = settings->type;
-    scene.experiment = std::move(settings);
-  }
+  readExperiment(root, scene);
 
   // [output]
   if (auto t = root.table("output")) {

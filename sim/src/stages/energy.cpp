@@ -1,9 +1,6 @@
 #include "../world_impl.h"
 
-
 namespace rocklab::sim {
-
-using detail::PairProps;
 
 // Mechanical energy at t (stage 5, observed steps only): kinetic from the
 // synchronised velocities, gravity, the contact springs, and what the force

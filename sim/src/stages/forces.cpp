@@ -1,9 +1,6 @@
 #include "../world_impl.h"
 
-
 namespace rocklab::sim {
-
-using detail::PairProps;
 
 // Stage 3, forces: the contact law at every pair and wall contact, gathered per
 // ball; on fused steps (StepPlan::fused) with the kick and drift of stage 7.

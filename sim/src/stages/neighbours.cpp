@@ -1,9 +1,6 @@
 #include "../world_impl.h"
 
-
 namespace rocklab::sim {
-
-using detail::PairProps;
 
 // Stage 2, neighbours.
 // Reads: positions, radii, clump membership, wall poses; the old lists.

@@ -1,9 +1,6 @@
 #include "../world_impl.h"
 
-
 namespace rocklab::sim {
-
-using detail::PairProps;
 
 // Stage 1, prepare.
 // Reads: time, the model's gravity schedule and wall motions, the largest

@@ -1,9 +1,6 @@
 #include "../world_impl.h"
 
-
 namespace rocklab::sim {
-
-using detail::PairProps;
 
 /// Takes every touching contact's overlap as its relaxation offset (first step
 /// of a world built with Model::relaxation.steps > 0).

@@ -4,8 +4,6 @@
 
 namespace rocklab::sim {
 
-using detail::PairProps;
-
 // Stage 6, watchdog: stops the run (WatchdogError, a message naming the body,
 // the time and the setting to change) on an overlap beyond
 // watchdog.max_overlap_fraction (every step), energy growth beyond the work of
@@ -75,7 +73,6 @@ bool World::Impl::energyCheckApplies() const {
   return model.watchdog.max_energy_growth > 0 && p.size() > 0;
 }
 
-
 void World::Impl::checkEnergy(const Energy& e) {
   if (!energyCheckApplies()) return;
   if (!guard.energy_ref_valid) {
@@ -121,6 +118,5 @@ void World::Impl::checkEnergy(const Energy& e) {
     << fmtNum(p.velocity[fastest].norm()) << " m/s. " << stepAdvice();
   throw WatchdogError(s.str());
 }
-
 
 }  // namespace rocklab::sim
