@@ -118,10 +118,10 @@ void iterateSpectrum(const ContactNetwork& network, double damping_weight, int i
     // x <- M^-1 K x
     for (std::size_t i = 0; i < n; ++i) {
       const NetworkBody& b = network.bodies[i];
-      const Vec3 t = b.inv_mass * part(g, i, 0), r = b.inv_inertia * part(g, i, 1);
+      const Vec3 t = b.inv_mass * part(g, i, 0), rot = b.inv_inertia * part(g, i, 1);
       for (int k = 0; k < 3; ++k) {
         x[6 * i + k] = t[k];
-        x[6 * i + 3 + k] = r[k];
+        x[6 * i + 3 + k] = rot[k];
       }
     }
   }

@@ -11,7 +11,7 @@
 // slip, and it creeps with its energy falling, which neither the energy nor the
 // overlap check can see (docs/stability.md).
 //
-// The leapfrog with the dashpot on the half-step velocity (stages 3 and 6 of
+// The leapfrog with the dashpot on the half-step velocity (stages 3 and 8 of
 // world.h) maps a mode x onto -x after one step exactly when
 //   (K + 2 C / dt) x = (4 / dt^2) M x,
 // (put x' = -x, v' = -v into v' = v - dt M^-1 (K x + C v), x' = x + dt v'), so

@@ -79,6 +79,16 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
   for (const WallHistory& h : state.wall_history)
     if (keep[h.particle]) walls.push_back({new_index[h.particle], h.wall, h.shear, h.relax_offset});
   state.wall_history = std::move(walls);
+  BondState& bonds = state.bonds;
+  std::vector<bool> keep_bond(bonds.size());
+  for (std::size_t e = 0; e < bonds.size(); ++e) keep_bond[e] = keep[bonds.a[e]] && keep[bonds.b[e]];
+#define ROCKLAB_COMPACT(type, name, unit, meaning) compact(bonds.name, keep_bond);
+  ROCKLAB_BOND_FIELDS(ROCKLAB_COMPACT)
+#undef ROCKLAB_COMPACT
+  for (std::size_t e = 0; e < bonds.size(); ++e) {
+    bonds.a[e] = new_index[bonds.a[e]];
+    bonds.b[e] = new_index[bonds.b[e]];
+  }
   return state;
 }
 

@@ -61,6 +61,9 @@ std::string TimestepAudit::describe(const TimestepSettings& settings) const {
   s << "time step audit:\n";
   s << "  spring, translational sqrt(m/k_n)    " << spring_translational << " s\n";
   s << "  spring, rotational sqrt(I/(k_s L^2)) " << spring_rotational << " s\n";
+  if (bond_translational > 0)
+    s << "  bonds, translational sqrt(m/sum k_n A) " << bond_translational << " s\n"
+      << "  bonds, rotational                    " << bond_rotational << " s\n";
   if (rayleigh > 0) s << "  Rayleigh                             " << rayleigh << " s\n";
   if (hertz_contact_time > 0)
     s << "  Hertz contact time at " << settings.impact_velocity << " m/s        "
@@ -81,7 +84,36 @@ std::string TimestepAudit::describe(const TimestepSettings& settings) const {
   return s.str();
 }
 
-TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) {
+namespace {
+
+/// The bond lines of the audit (TimestepAudit::bond_translational, _rotational).
+void auditBonds(const Model& model, const ParticleState& p, const BondState& bonds, TimestepAudit& a) {
+  const std::size_t n = p.size();
+  std::vector<double> k_tran(n, 0.0), k_rot(n, 0.0);
+  const double kn = model.bonds.normal_stiffness, ks = model.bonds.shear_stiffness;
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    if (!bonds.intact[k]) continue;
+    const BondDisc d = bondDisc(bonds.radius[k]);
+    const double bend_twist = std::max(kn * d.inertia, ks * d.polar);
+    for (const std::uint32_t i : {bonds.a[k], bonds.b[k]}) {
+      k_tran[i] += kn * d.area;
+      // Lever: the ball's radius (its centre to the bond) for a sphere.
+      k_rot[i] += ks * d.area * p.radius[i] * p.radius[i] + bend_twist;
+    }
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  double tran = inf, rot = inf;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (k_tran[i] > 0) tran = std::min(tran, std::sqrt(p.mass[i] / k_tran[i]));
+    if (k_rot[i] > 0) rot = std::min(rot, std::sqrt(1.0 / (p.inv_inertia[i] * k_rot[i])));
+  }
+  if (std::isfinite(tran)) a.bond_translational = tran;
+  if (std::isfinite(rot)) a.bond_rotational = rot;
+}
+
+}  // namespace
+
+TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, const BondState& bonds) {
   using detail::PairProps;
   const double inf = std::numeric_limits<double>::infinity();
   TimestepAudit a;
@@ -170,6 +202,8 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles) 
       rayleigh = std::min(rayleigh, rayleighStep(r, mi.density, mi.shear_modulus, mi.poisson));
   }
   a.critical = std::min(a.spring_translational, a.spring_rotational);
+  auditBonds(model, particles, bonds, a);
+  if (a.bond_translational > 0) a.critical = std::min({a.critical, a.bond_translational, a.bond_rotational});
   a.rayleigh = std::isfinite(rayleigh) ? rayleigh : 0.0;
   a.hertz_contact_time = std::isfinite(hertz_time) ? hertz_time : 0.0;
   if (!hertz && std::isfinite(lightest) && lightest_k > 0)

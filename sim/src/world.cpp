@@ -18,6 +18,7 @@ const char* stageName(Stage s) {
     case Stage::Prepare: return "prepare";
     case Stage::Neighbours: return "neighbours";
     case Stage::Forces: return "forces";
+    case Stage::Bonds: return "bonds";
     case Stage::ExtraForces: return "extra_forces";
     case Stage::Observe: return "observe";
     case Stage::Watchdog: return "watchdog";
@@ -40,9 +41,10 @@ StepPlan World::Impl::planStep(bool observed) const {
   plan.network_due =
       model.watchdog.network_iterations > 0 && step % static_cast<std::uint64_t>(network_every) == 0;
   plan.observe = observed || plan.energy_due || plan.network_due;
+  plan.bonds = bonds.intact > 0;
   // The kick needs every force of the step: fused into the contact pass only
-  // when no snapshot is taken before it and no contribution adds forces after it.
-  plan.fused = !plan.observe && contributions.empty();
+  // when no snapshot is taken before it and no bond or contribution adds forces after it.
+  plan.fused = !plan.observe && !plan.bonds && contributions.empty();
   return plan;
 }
 
@@ -61,17 +63,21 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     StageTimer timer(stageSeconds(Stage::Forces));
     forceStage(plan, checks);  // 3
   }
+  if (plan.bonds) {
+    StageTimer timer(stageSeconds(Stage::Bonds));
+    bondStage();  // 4
+  }
   if (!contributions.empty()) {
     StageTimer timer(stageSeconds(Stage::ExtraForces));
-    extraForceStage();  // 4
+    extraForceStage();  // 5
   }
   if (plan.observe) {
     StageTimer timer(stageSeconds(Stage::Observe));
-    observeStage();  // 5
+    observeStage();  // 6
   }
   {
     StageTimer timer(stageSeconds(Stage::Watchdog));
-    watchdogStage(plan, checks);  // 6
+    watchdogStage(plan, checks);  // 7
   }
   if (observer) {
     // The whole-step snapshot, before the kick; the observer's own time is the caller's.
@@ -80,7 +86,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     observer(snapshot(total_force, wall_active));
   }
   StageTimer timer(stageSeconds(Stage::Integrate));
-  integrateStage(plan, checks);  // 7
+  integrateStage(plan, checks);  // 8
   finishStep(checks);
 }
 
@@ -100,6 +106,9 @@ const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
 const WorldStats& World::stats() const { return impl_->stats; }
 int World::threads() const { return impl_->teamSize(); }
 Vec3 World::gravity() const { return impl_->gravity; }
+const BondState& World::bonds() const { return impl_->bonds.state; }
+std::size_t World::intactBonds() const { return impl_->bonds.intact; }
+const std::vector<BondBreak>& World::bondBreaks() const { return impl_->bonds.breaks; }
 
 WorldState World::exportState() const {
   const Impl& w = *impl_;
@@ -109,6 +118,7 @@ WorldState World::exportState() const {
   s.dt = w.dt;
   s.half_kick_pending = w.half_kick_pending;
   s.particles = w.p;
+  s.bonds = w.bonds.state;
   for (std::size_t i = 0; i + 1 < w.nb.pairs.row_offset.size(); ++i)
     for (std::uint32_t k = w.nb.pairs.row_offset[i]; k < w.nb.pairs.row_offset[i + 1]; ++k)
       if (!w.history.pair_shear[k].isZero(0) || (w.relax.active() && w.relax.pair[k] > 0))

@@ -102,6 +102,7 @@ struct StepPlan {
   bool network_due = false;    // the contact-network step check
   bool observe = false;        // velocities synchronised to t and the energy are needed
   bool fused = false;          // integration runs inside the contact pass (stage 3)
+  bool bonds = false;          // intact bonds to update (stage 4)
 };
 
 struct World::Impl {
@@ -122,7 +123,20 @@ struct World::Impl {
   std::vector<detail::PairProps> ball_ball, ball_wall;
   std::size_t nm = 0;
   std::vector<detail::WallRuntime> walls;  // pose and activity at t (stage 1)
-  std::vector<std::shared_ptr<ForceContribution>> contributions;  // stage 4, in this order
+  std::vector<std::shared_ptr<ForceContribution>> contributions;  // stage 5, in this order
+
+  // --- parallel bonds (stage 4 writes; saved by exportState); empty without bonds
+  struct Bonds {
+    BondState state;
+    std::size_t intact = 0;                   // bonds not yet broken
+    std::vector<std::uint32_t> ball_offset;   // [n+1] rows of ball_end by ball
+    std::vector<std::uint32_t> ball_end;      // 2 bond + (0: the ball is a, 1: it is b), by bond
+    std::vector<Vec3> force_b;                // [bonds] N, this step's force on b (on a: minus it)
+    std::vector<Vec3> torque_a, torque_b;     // [bonds] N m, about each ball's centre
+    std::vector<std::uint8_t> broke;          // [bonds] 1 when it broke at this step
+    std::vector<BondBreak> breaks;            // every breakage since this World was built
+    bool any() const { return state.size() > 0; }
+  } bonds;
 
   // --- neighbour lists (stage 2 writes, stages 3-6 read)
   struct NeighbourLists {
@@ -144,7 +158,7 @@ struct World::Impl {
     std::vector<std::uint8_t> wall_touch;    // [k]
   } history;
 
-  // --- force scratch (stages 3 and 4 write, 5 and 7 read)
+  // --- force scratch (stages 3-5 write, 6 and 8 read)
   struct ForceScratch {
     struct CrossSlot {
       Vec3 fi, ti, fj, tj;  // N, N m on the first and the second ball
@@ -156,7 +170,7 @@ struct World::Impl {
     std::vector<Vec3> acc_force, acc_torque;  // [n] N, N m: contacts and contributions, no gravity
   } scratch;
 
-  // --- observation (stage 5 writes on observed steps)
+  // --- observation (stage 6 writes on observed steps)
   struct Observation {
     std::vector<Vec3> velocity, omega;              // [n] synchronised to t
     std::vector<Vec3> clump_velocity, clump_omega;  // [c]
@@ -164,7 +178,7 @@ struct World::Impl {
     Energy energy;
   } obs;
 
-  // --- watchdog (stage 6)
+  // --- watchdog (stage 7)
   struct Guard {
     bool energy_ref_valid = false;
     double energy_ref = 0.0, energy_scale = 0.0;  // J
@@ -235,16 +249,22 @@ struct World::Impl {
   bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
   template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
-  // 4. extra forces (stages/extra_forces.cpp)
+  // 4. bonds (stages/bonds.cpp)
+  void bondStage();
+  void installBonds(const std::vector<BondSpec>& specs);
+  void indexBonds();
+  double bondEnergy() const;
+  void bondSprings(std::vector<NetworkSpring>& out) const;
+  // 5. extra forces (stages/extra_forces.cpp)
   void extraForceStage();
   ForceInput forceInput() const { return ForceInput{time, dt, p}; }
-  // 5. observe (stages/observe.cpp, stages/energy.cpp)
+  // 6. observe (stages/observe.cpp, stages/energy.cpp)
   void observeStage();
   Snapshot snapshot(std::vector<Vec3>& total_force, std::vector<std::uint8_t>& wall_active) const;
   void clumpLoad(std::size_t c, Vec3& force, Vec3& torque) const;
   Energy energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
   template <class Law> Energy energy(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const;
-  // 6. watchdog (stages/watchdog.cpp, stages/network_check.cpp)
+  // 7. watchdog (stages/watchdog.cpp, stages/network_check.cpp)
   void watchdogStage(const StepPlan& plan, const StepChecks& checks);
   void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
@@ -253,7 +273,7 @@ struct World::Impl {
   void checkNetworkStep();
   template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
   std::string stepAdvice() const;
-  // 7. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)
+  // 8. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)
   void integrateStage(const StepPlan& plan, StepChecks& checks);
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);
   void integrateClumps(double h, StepChecks& merged);

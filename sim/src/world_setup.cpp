@@ -86,11 +86,63 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
   return {};
 }
 
+namespace {
+
+/// "" or what is wrong with the bonds of a world of `p`'s balls.
+std::string validateBonds(const ParallelBondModel& bm, const ParticleState& p, const BondState& bonds) {
+  if (bonds.size() == 0) return {};
+  std::ostringstream e;
+  if (!(bm.radius_multiplier > 0) || !std::isfinite(bm.radius_multiplier)) {
+    e << "bonds.radius_multiplier = " << bm.radius_multiplier << ": must be > 0";
+    return e.str();
+  }
+  if (!(bm.normal_stiffness > 0) || !std::isfinite(bm.normal_stiffness)) {
+    e << "bonds.normal_stiffness = " << bm.normal_stiffness << " Pa/m: must be > 0";
+    return e.str();
+  }
+  if (!(bm.shear_stiffness >= 0) || !std::isfinite(bm.shear_stiffness)) {
+    e << "bonds.shear_stiffness = " << bm.shear_stiffness << " Pa/m: must be >= 0";
+    return e.str();
+  }
+  const std::size_t n = p.size();
+  for (std::size_t k = 0; k < bonds.size(); ++k) {
+    const std::uint32_t a = bonds.a[k], b = bonds.b[k];
+    if (a >= n || b >= n) {
+      e << "bond " << k << ": ball " << std::max(a, b) << " does not exist (the world has " << n << " balls)";
+      return e.str();
+    }
+    if (a == b) {
+      e << "bond " << k << ": joins ball " << a << " to itself";
+      return e.str();
+    }
+    if (!p.clump.empty() && p.clump[a] >= 0 && p.clump[a] == p.clump[b]) {
+      e << "bond " << k << ": balls " << a << " and " << b << " are members of one rigid clump";
+      return e.str();
+    }
+    if (!(bonds.tensile_strength[k] > 0) || !(bonds.shear_strength[k] > 0)) {
+      e << "bond " << k << ": strengths must be > 0 Pa (tensile " << bonds.tensile_strength[k] << ", shear "
+        << bonds.shear_strength[k] << ")";
+      return e.str();
+    }
+    if (!(bonds.radius[k] > 0) || !bonds.normal[k].allFinite() || std::abs(bonds.normal[k].norm() - 1.0) > 1e-6) {
+      e << "bond " << k << ": radius must be > 0 m and the normal a unit vector";
+      return e.str();
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 World::World(Model model, const std::vector<SphereSpec>& spheres, int threads)
-    : World(std::move(model), spheres, {}, threads) {}
+    : World(std::move(model), spheres, {}, {}, threads) {}
 
 World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
              int threads)
+    : World(std::move(model), spheres, clumps, {}, threads) {}
+
+World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
+             const std::vector<BondSpec>& bond_specs, int threads)
     : impl_(std::make_unique<Impl>()) {
   const std::string msg = validateModel(model, spheres, clumps);
   if (!msg.empty()) throw std::invalid_argument(msg);
@@ -147,7 +199,17 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vec
       w.placeMembers(c);
     }
   }
-  w.audit = auditTimestep(w.model, p);
+  for (std::size_t k = 0; k < bond_specs.size(); ++k)
+    if (bond_specs[k].a >= n || bond_specs[k].b >= n) {
+      std::ostringstream e;
+      e << "bond " << k << ": ball " << std::max(bond_specs[k].a, bond_specs[k].b)
+        << " does not exist (the world has " << n << " balls)";
+      throw std::invalid_argument(e.str());
+    }
+  w.installBonds(bond_specs);
+  if (const std::string bad = validateBonds(w.model.bonds, p, w.bonds.state); !bad.empty())
+    throw std::invalid_argument(bad);
+  w.audit = auditTimestep(w.model, p, w.bonds.state);
   w.dt = w.audit.chosen;
   w.initialise(threads);
   w.relax.pending = w.model.relaxation.steps > 0;
@@ -159,10 +221,14 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
   const std::string msg = validateModel(w.model, {});
   if (!msg.empty()) throw std::invalid_argument(msg);
   w.p = std::move(state.particles);
+  if (const std::string bad = validateBonds(w.model.bonds, w.p, state.bonds); !bad.empty())
+    throw std::invalid_argument("checkpoint: " + bad);
+  w.bonds.state = std::move(state.bonds);
+  w.indexBonds();
   w.time = state.time;
   w.step = state.step;
   w.half_kick_pending = state.half_kick_pending;
-  if (w.p.size() > 0) w.audit = auditTimestep(w.model, w.p);  // nothing to audit in an empty world
+  if (w.p.size() > 0) w.audit = auditTimestep(w.model, w.p, w.bonds.state);  // nothing to audit in an empty world
   w.audit.chosen = state.dt;  // the run continues with the step it had
   w.dt = state.dt;
   w.initialise(threads);

@@ -86,6 +86,22 @@ std::string inconsistency(const WorldState& state) {
              std::to_string(h.j) + ") but there are " + std::to_string(n) + " particles";
     }
   }
+  const BondState& b = state.bonds;
+#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, b.name.size()},
+  const std::pair<const char*, std::size_t> bond_sizes[] = {ROCKLAB_BOND_FIELDS(ROCKLAB_SIZE)};
+#undef ROCKLAB_SIZE
+  for (const auto& [name, size] : bond_sizes) {
+    if (size != b.size()) {
+      return "inconsistent array sizes: bonds/" + std::string(name) + " has " + std::to_string(size) +
+             " entries but bonds/a has " + std::to_string(b.size());
+    }
+  }
+  for (std::size_t e = 0; e < b.size(); ++e) {
+    if (b.a[e] >= n || b.b[e] >= n) {
+      return "bond " + std::to_string(e) + " joins balls (" + std::to_string(b.a[e]) + ", " +
+             std::to_string(b.b[e]) + ") but there are " + std::to_string(n) + " particles";
+    }
+  }
   for (const WallHistory& h : state.wall_history) {
     if (h.particle >= n) {
       return "wall history refers to particle " + std::to_string(h.particle) + " but there are " +
@@ -136,6 +152,15 @@ void writeParticles(const H5::Group& root, const ParticleState& p) {
   writeArray(clumps, "member_offset", k.member_offset, "m");
 }
 
+/// Bonds (only in a world that has them): every field of the bond table.
+void writeBonds(const H5::Group& root, const BondState& b) {
+  if (b.size() == 0) return;
+  const H5::Group group = root.createGroup("bonds");
+#define ROCKLAB_WRITE(type, name, unit, meaning) writeArray(group, #name, b.name, unit);
+  ROCKLAB_BOND_FIELDS(ROCKLAB_WRITE)
+#undef ROCKLAB_WRITE
+}
+
 void writeFile(const std::filesystem::path& path, const WorldState& state,
                const std::string& scene_text) {
   H5::H5File file(path.string(), H5F_ACC_TRUNC);
@@ -150,6 +175,7 @@ void writeFile(const std::filesystem::path& path, const WorldState& state,
   writeParticles(file, state.particles);
   writeHistory(file, kPairLayout, state.pair_history);
   writeHistory(file, kWallLayout, state.wall_history);
+  writeBonds(file, state.bonds);
   file.close();
 }
 
@@ -298,6 +324,15 @@ ParticleState readParticles(const Reader& in) {
   return p;
 }
 
+BondState readBonds(const Reader& in) {
+  BondState b;
+  if (!in.has("/bonds")) return b;  // a run without bonds
+#define ROCKLAB_READ(type, name, unit, meaning) b.name = in.array<type>("/bonds/" #name);
+  ROCKLAB_BOND_FIELDS(ROCKLAB_READ)
+#undef ROCKLAB_READ
+  return b;
+}
+
 Checkpoint readFile(const Reader& in) {
   in.checkFormat();
   Checkpoint checkpoint;
@@ -310,6 +345,7 @@ Checkpoint readFile(const Reader& in) {
   state.particles = readParticles(in);
   state.pair_history = readHistory(in, kPairLayout);
   state.wall_history = readHistory(in, kWallLayout);
+  state.bonds = readBonds(in);
   if (const std::string problem = inconsistency(state); !problem.empty()) in.fail(problem);
   return checkpoint;
 }

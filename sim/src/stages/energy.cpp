@@ -2,7 +2,7 @@
 
 namespace rocklab::sim {
 
-// Mechanical energy at t (stage 5, observed steps only): kinetic from the
+// Mechanical energy at t (stage 6, observed steps only): kinetic from the
 // synchronised velocities, gravity, the contact springs, and what the force
 // contributions store.
 
@@ -45,6 +45,7 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
 Energy World::Impl::energyAny(const std::vector<Vec3>& v, const std::vector<Vec3>& w) const {
   Energy e = model.contact.law == ContactLaw::Linear ? energy<detail::LinearLaw>(v, w)
                                                      : energy<detail::HertzMindlinLaw>(v, w);
+  if (bonds.any()) e.bond = bondEnergy();
   if (!contributions.empty()) {
     const ForceInput in = forceInput();
     for (const auto& contribution : contributions) e.potential_other += contribution->potentialEnergy(in);

@@ -2,7 +2,7 @@
 
 namespace rocklab::sim {
 
-// Stage 4, extra forces: the force contributions (force_contribution.h) add
+// Stage 5, extra forces: the force contributions (force_contribution.h) add
 // into the accumulators after the contact pass has finished every ball, one
 // contribution after the other in the order they were added, on this thread:
 // each ball's sums keep one order on any number of threads.

@@ -3,11 +3,11 @@
 namespace rocklab::sim {
 
 // Stage 3, forces: the contact law at every pair and wall contact, gathered per
-// ball; on fused steps (StepPlan::fused) with the kick and drift of stage 7.
+// ball; on fused steps (StepPlan::fused) with the kick and drift of stage 8.
 // Reads: positions, velocities, spins (t - dt/2), radii, materials, nb, walls.
 // Writes: scratch.acc_force/acc_torque (set outright), history (shear springs,
 // touching flags), the watchdog's wall work, the step checks; on fused steps
-// the integrated state as stage 7 would.
+// the integrated state as stage 8 would.
 // The contact law, the pass and its caller are in this one unit so that
 // evaluatePair and addWallForces inline into the pass.
 //

@@ -4,7 +4,7 @@
 
 namespace rocklab::sim {
 
-// Stage 7, integrate: leapfrog kick and drift (Eq 2-11..2-13) with local
+// Stage 8, integrate: leapfrog kick and drift (Eq 2-11..2-13) with local
 // damping (Eq 2-15) for free balls (World::Impl::integrate, world_impl.h) and
 // rigid clumps (Eq 2-44..2-46, free rotation in rigid_body.h), then the clock.
 // Reads: scratch.acc_force/acc_torque (contacts and contributions), gravity.

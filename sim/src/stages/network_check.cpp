@@ -7,7 +7,7 @@ namespace rocklab::sim {
 
 using detail::PairProps;
 
-// Stage 6 (part), the contact-network step check (contact_spectrum.h): every
+// Stage 7 (part), the contact-network step check (contact_spectrum.h): every
 // touching contact and contribution spring as a spring-dashpot between rigid
 // bodies; power iteration for the fastest mode; stops when dt exceeds its
 // stable step. Reads: the contact lists and history, positions, clumps.
@@ -88,9 +88,11 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
           history.wall_shear[w]);
     }
   }
-  // Springs of the force contributions (bonds): checked like contacts.
-  if (contributions.empty()) return;
+  // Springs of the bonds and the force contributions: checked like contacts
+  // (the peers that left bonds out were asked for it by their users).
+  if (contributions.empty() && bonds.intact == 0) return;
   std::vector<NetworkSpring> springs;
+  if (bonds.intact > 0) bondSprings(springs);
   const ForceInput in = forceInput();
   for (const auto& contribution : contributions) contribution->networkSprings(in, springs);
   for (const NetworkSpring& s : springs) {

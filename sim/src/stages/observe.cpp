@@ -3,7 +3,7 @@
 
 namespace rocklab::sim {
 
-// Stage 5, observe (only on steps an observer, the energy check or the network
+// Stage 6, observe (only on steps an observer, the energy check or the network
 // check asked for): the whole-step state before the kick.
 // Reads: velocities and spins at t - dt/2, scratch.acc_force/acc_torque, clumps.
 // Writes: obs (velocities synchronised to t, v(t) = v(t - dt/2) + a(t) dt/2,
@@ -39,7 +39,7 @@ void World::Impl::observeStage() {
   obs.energy = energyAny(obs.velocity, obs.omega);
 }
 
-/// The observer's view of stage 5's results; the two buffers hold what the
+/// The observer's view of stage 6's results; the two buffers hold what the
 /// snapshot's spans point at and must outlive the observer call.
 Snapshot World::Impl::snapshot(std::vector<Vec3>& total_force, std::vector<std::uint8_t>& wall_active) const {
   const std::size_t n = p.size();

@@ -4,7 +4,7 @@
 
 namespace rocklab::sim {
 
-// Stage 6, watchdog: stops the run (WatchdogError, a message naming the body,
+// Stage 7, watchdog: stops the run (WatchdogError, a message naming the body,
 // the time and the setting to change) on an overlap beyond
 // watchdog.max_overlap_fraction (every step), energy growth beyond the work of
 // the moving walls (when computed) and a step the contact network cannot take

@@ -9,6 +9,7 @@
 #include "rocklab/geometry/packing.h"  // geometry::Sphere
 #include "rocklab/geometry/triangle_mesh.h"
 #include "rocklab/geometry/vec.h"
+#include "rocklab/sim/bonds.h"
 
 namespace rocklab::sim {
 
@@ -132,6 +133,7 @@ struct Model {
   TimestepSettings timestep;
   WatchdogSettings watchdog;
   OverlapRelaxation relaxation;
+  ParallelBondModel bonds;  // used only by worlds built with bonds
   double skin = 0.0;  // m  Verlet skin; 0 = 0.2 x mean radius
   int max_grid_levels = 8;  // neighbour grid levels (one per doubling of the radius); 1 = plain grid
 };

@@ -16,9 +16,10 @@ struct Energy {
   double kinetic_rotational = 0.0;     // J
   double potential_gravity = 0.0;      // J, -sum m g.x (datum at the origin)
   double elastic = 0.0;                // J, stored in normal and shear contact springs
+  double bond = 0.0;                   // J, stored in intact parallel bonds (bonds.h)
   double potential_other = 0.0;        // J, stored by force contributions (force_contribution.h)
   double total() const {
-    return kinetic_translational + kinetic_rotational + potential_gravity + elastic + potential_other;
+    return kinetic_translational + kinetic_rotational + potential_gravity + elastic + bond + potential_other;
   }
 };
 

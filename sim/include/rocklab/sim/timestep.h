@@ -2,6 +2,7 @@
 // Critical time steps (ref. dem-models.md §7a, [X]) and the start-up audit.
 #include <string>
 
+#include "rocklab/sim/bonds.h"
 #include "rocklab/sim/model.h"
 #include "rocklab/sim/particles.h"
 
@@ -54,7 +55,14 @@ inline constexpr double kDashpotMultiplicity = 2.0;
 struct TimestepAudit {
   double spring_translational = 0.0;  // s  sqrt(m/k_n), stiffest pair of the lightest body
   double spring_rotational = 0.0;     // s  sqrt(I/(k_s L^2)), L = lever (R for a sphere)
-  double critical = 0.0;              // s  min of the two
+  // s  parallel bonds (0 without): each ball against the sum of its bonds'
+  // springs (ref §7a: k_tran and k_rot are sums over the contacts and bonds
+  // acting on a body): sqrt(m / sum k_n A), and sqrt(I / sum (k_s A L^2 +
+  // max(k_n I_b, k_s J_b))) with L the bond's lever (bonds hold a ball from
+  // every side at once, unlike the contacts of a pile, so their sum counts).
+  double bond_translational = 0.0;
+  double bond_rotational = 0.0;
+  double critical = 0.0;              // s  min of the springs (contacts and bonds)
   double rayleigh = 0.0;              // s  0 when no shear modulus is given (linear law)
   double hertz_contact_time = 0.0;    // s  at impact_velocity; 0 for the linear law
   double linear_contact_time = 0.0;   // s  lightest ball on its stiffest partner; 0 for Hertz
@@ -69,8 +77,9 @@ struct TimestepAudit {
 };
 
 /// Audits the step for the given balls against every partner they can meet
-/// (other balls' materials and every wall). Throws std::invalid_argument when a
-/// requested dt exceeds the automatic one (unless timestep.allow_unsafe).
-TimestepAudit auditTimestep(const Model& model, const ParticleState& particles);
+/// (other balls' materials and every wall) and their intact bonds. Throws
+/// std::invalid_argument when a requested dt exceeds the automatic one (unless
+/// timestep.allow_unsafe).
+TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, const BondState& bonds = {});
 
 }  // namespace rocklab::sim

@@ -9,19 +9,23 @@
 //   2. neighbours    rebuild pair and wall-candidate lists when due (history
 //                    carried over); relaxation offsets of initial overlaps
 //   3. forces        contact law at every pair and wall contact, summed per ball
-//                    in a fixed order; on steps that nothing observes and with no
-//                    force contributions, fused with the kick and drift (stage 7)
-//   4. extra forces  force contributions (force_contribution.h, e.g. bonds) add
-//                    into the accumulators in a fixed order; only when present
-//   5. observe       only on observed steps: velocities synchronised to t, energy
-//   6. watchdog      overlap limit (every step); energy growth and the contact
+//                    in a fixed order; on steps that nothing observes, with no
+//                    intact bonds and no force contributions, fused with the
+//                    kick and drift (stage 8)
+//   4. bonds         parallel bonds (bonds.h): update, breakage, forces and
+//                    moments into the accumulators; only when the world has bonds
+//   5. extra forces  force contributions (force_contribution.h) add into the
+//                    accumulators in a fixed order; only when present
+//   6. observe       only on observed steps: velocities synchronised to t, energy
+//   7. watchdog      overlap limit (every step); energy growth and the contact
 //                    network's step when due (observed steps)
-//   7. integrate     leapfrog kick and drift (Eq 2-11..2-13), local damping,
+//   8. integrate     leapfrog kick and drift (Eq 2-11..2-13), local damping,
 //                    clumps as rigid bodies (Eq 2-44..2-46); clock; NaN guard
 //
-// The observer is called between stages 6 and 7 with the whole-step snapshot.
-// Threads: stages 2, 3 and 7 run over balls with OpenMP static schedules; every
-// ball's sums are formed in the same order whatever the number of threads.
+// The observer is called between stages 7 and 8 with the whole-step snapshot.
+// Threads: stages 2, 3, 4 and 8 run over balls (bonds) with OpenMP static
+// schedules; every ball's sums are formed in the same order whatever the number
+// of threads.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -30,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "rocklab/sim/bonds.h"
 #include "rocklab/sim/force_contribution.h"
 #include "rocklab/sim/model.h"
 #include "rocklab/sim/particles.h"
@@ -67,10 +72,11 @@ struct WorldState {
   ParticleState particles;
   std::vector<PairHistory> pair_history;
   std::vector<WallHistory> wall_history;
+  BondState bonds;  // every bond, intact and broken; empty without bonds
 };
 
 /// The stages of one step, in their order (see the head of this file).
-enum class Stage { Prepare, Neighbours, Forces, ExtraForces, Observe, Watchdog, Integrate, Count };
+enum class Stage { Prepare, Neighbours, Forces, Bonds, ExtraForces, Observe, Watchdog, Integrate, Count };
 inline constexpr std::size_t kStageCount = static_cast<std::size_t>(Stage::Count);
 /// Stage names as results.json reports them ("prepare", "extra_forces", ...).
 const char* stageName(Stage s);
@@ -93,6 +99,10 @@ class World {
   /// The same with rigid clumps; their member balls follow the free spheres.
   World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
         int threads = 0);
+  /// The same with parallel bonds (Model::bonds) between its balls, installed
+  /// stress-free where the balls are now.
+  World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
+        const std::vector<BondSpec>& bonds, int threads = 0);
   /// Restarts from a saved state (dt is taken from the state).
   World(Model model, WorldState state, int threads = 0);
   ~World();
@@ -113,6 +123,12 @@ class World {
   /// Threads the step really uses: the requested ones, fewer for small worlds.
   int threads() const;
   Vec3 gravity() const;
+  /// Every bond, intact and broken, as of the last step.
+  const BondState& bonds() const;
+  std::size_t intactBonds() const;
+  /// Every breakage since this World was built, in the order they happened
+  /// (within a step by bond index).
+  const std::vector<BondBreak>& bondBreaks() const;
 
   /// Adds forces other than contacts (force_contribution.h); called in the
   /// `extra forces` stage in the order added. A world with contributions no
@@ -130,7 +146,8 @@ class World {
 };
 
 /// Removes balls from a saved state, together with the whole clump of any
-/// removed member; indices in the contact history are renumbered and ids kept.
+/// removed member and every bond of a removed ball; indices in the contact
+/// history and the bonds are renumbered and ids kept.
 /// A World rebuilt from the result (World(model, state)) continues the run
 /// without them: this is how experiments drop discharged pebbles or the clumps
 /// cut by a plate added after deposition.

@@ -1,0 +1,279 @@
+#include <numbers>
+#include <sstream>
+
+#include "../world_impl.h"
+
+namespace rocklab::sim {
+
+// Stage 4, bonds: every intact parallel bond (bonds.h, dem-models.md §8.2) is
+// updated from the relative motion of its two balls, checked against its
+// strengths, and its force and moment are added into the balls' accumulators.
+// Reads: positions at t, velocities and spins at t - dt/2; bonds.state.
+// Writes: bonds.state (forces, moments, frame; intact -> 0 on breakage), the
+// per-bond scratch, scratch.acc_force/acc_torque (adds), bonds.breaks.
+//
+// Threads: the update runs over bonds (each writes only its own entries), the
+// sums over balls, each adding its bonds in ascending bond order: bitwise the
+// same on any number of threads.
+
+const char* bondFailureModeName(BondFailureMode mode) {
+  return mode == BondFailureMode::Tensile ? "tensile" : "shear";
+}
+
+BondDisc bondDisc(double radius) {
+  BondDisc d;
+  d.radius = radius;
+  const double r2 = radius * radius;
+  d.area = std::numbers::pi * r2;                 // Eq 2-36
+  d.polar = 0.5 * std::numbers::pi * r2 * r2;     // Eq 2-37
+  d.inertia = 0.25 * std::numbers::pi * r2 * r2;  // Eq 2-38
+  return d;
+}
+
+BondStress bondStress(const BondDisc& d, double normal_force, const Vec3& shear_force,
+                      double twist_moment, const Vec3& bend_moment) {
+  BondStress s;
+  s.tensile = -normal_force / d.area + bend_moment.norm() * d.radius / d.inertia;  // Eq 2-33 [R]
+  s.shear =
+      shear_force.norm() / d.area + std::abs(twist_moment) * d.radius / d.polar;  // Eq 2-34 [R]
+  return s;
+}
+
+namespace {
+
+/// v (in the plane normal to n_old) carried to the plane normal to n, by the
+/// rotation taking n_old to n (Rodrigues with the unnormalised axis
+/// k = n_old x n, |k| = sin, so k (k.v) (1 - cos) / sin^2 = k (k.v) / (1 + cos)).
+inline Vec3 tiltWith(const Vec3& v, const Vec3& n_old, const Vec3& n) {
+  const Vec3 k = n_old.cross(n);
+  const double c = n_old.dot(n);
+  if (c <= -1.0 + 1e-12) return v;  // turned over in one step: no defined rotation
+  return c * v + k.cross(v) + k * (k.dot(v) / (1.0 + c));
+}
+
+/// v (in the plane normal to n) turned about n by `angle`; the series is exact to
+/// round-off for the tiny angles of one step and saves two trigonometric calls.
+inline Vec3 twistAbout(const Vec3& v, const Vec3& n, double angle) {
+  double s, c;
+  if (std::abs(angle) < 1e-3) {
+    const double a2 = angle * angle;
+    s = angle * (1.0 - a2 / 6.0);
+    c = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
+  } else {
+    s = std::sin(angle);
+    c = std::cos(angle);
+  }
+  return c * v + s * n.cross(v);
+}
+
+/// What one bond does in this step.
+struct BondOutcome {
+  bool broke = false;
+  BondFailureMode mode = BondFailureMode::Tensile;
+  BondStress stress;
+};
+
+}  // namespace
+
+void World::Impl::bondStage() {
+  BondState& s = bonds.state;
+  const ParallelBondModel& bm = model.bonds;
+  const double kn = bm.normal_stiffness, ks = bm.shear_stiffness;
+  const bool combined = bm.failure_rule == BondFailureRule::Combined;
+  const auto nbonds = static_cast<std::ptrdiff_t>(s.size());
+  const double h = dt;
+  bool any_broke = false;
+#pragma omp parallel for schedule(static) num_threads(teamSize()) reduction(|| : any_broke)
+  for (std::ptrdiff_t kk = 0; kk < nbonds; ++kk) {
+    const auto k = static_cast<std::size_t>(kk);
+    bonds.broke[k] = 0;
+    if (!s.intact[k]) continue;
+    const std::uint32_t a = s.a[k], b = s.b[k];
+    const Vec3& xa = p.position[a];
+    const Vec3& xb = p.position[b];
+    const Vec3 d = xb - xa;
+    const double dist = d.norm();
+    const Vec3 n_old = s.normal[k];
+    const Vec3 n = dist > 0 ? Vec3(d / dist) : n_old;
+    // The bond acts at the middle of the gap (or overlap) between the surfaces.
+    const double gap = dist - p.radius[a] - p.radius[b];
+    const Vec3 xc = xa + n * (p.radius[a] + 0.5 * gap);
+    // Stored shear force and bending moment turn with the contact plane: its
+    // tilt (n_old -> n) and its spin about n, the mean of the balls' spins.
+    const double spin = 0.5 * (p.omega[a] + p.omega[b]).dot(n) * h;
+    auto carry = [&](const Vec3& v) {
+      Vec3 r = twistAbout(tiltWith(v, n_old, n), n, spin);
+      return Vec3(r - r.dot(n) * n);  // no round-off drift out of the plane
+    };
+    // Increments (Eq 2-29..2-32): relative motion of b against a at the bond.
+    const Vec3 v_rel =
+        (p.velocity[b] + p.omega[b].cross(xc - xb)) - (p.velocity[a] + p.omega[a].cross(xc - xa));
+    const double du_n = v_rel.dot(n) * h;  // > 0 when separating
+    const Vec3 du_s = (v_rel - v_rel.dot(n) * n) * h;
+    const Vec3 dtheta = (p.omega[b] - p.omega[a]) * h;
+    const double dtheta_n = dtheta.dot(n);
+    const Vec3 dtheta_s = dtheta - dtheta_n * n;
+    const BondDisc disc = bondDisc(s.radius[k]);
+    const double fn = s.normal_force[k] - kn * disc.area * du_n;               // Eq 2-29
+    const Vec3 fs = carry(s.shear_force[k]) - (ks * disc.area) * du_s;         // Eq 2-30 [R]
+    const double mn = s.twist_moment[k] - ks * disc.polar * dtheta_n;          // Eq 2-31 [R]
+    const Vec3 ms = carry(s.bend_moment[k]) - (kn * disc.inertia) * dtheta_s;  // Eq 2-32
+    s.normal[k] = n;
+    s.normal_force[k] = fn;
+    s.shear_force[k] = fs;
+    s.twist_moment[k] = mn;
+    s.bend_moment[k] = ms;
+
+    const BondStress stress = bondStress(disc, fn, fs, mn, ms);
+    double tensile_ratio, shear_ratio;
+    if (combined) {
+      // Each force or moment against its own capacity; the parts add up.
+      tensile_ratio = std::max(-fn, 0.0) / (s.tensile_strength[k] * disc.area) +
+                      ms.norm() * disc.radius / (s.tensile_strength[k] * disc.inertia);
+      shear_ratio = fs.norm() / (s.shear_strength[k] * disc.area) +
+                    std::abs(mn) * disc.radius / (s.shear_strength[k] * disc.polar);
+    } else {
+      tensile_ratio = stress.tensile / s.tensile_strength[k];
+      shear_ratio = stress.shear / s.shear_strength[k];
+    }
+    const bool broke = combined ? tensile_ratio + shear_ratio >= 1.0
+                                : (tensile_ratio >= 1.0 || shear_ratio >= 1.0);
+    if (broke) {
+      // Deleted at once (ref §8.2): it carries nothing in the step it breaks, so
+      // a pair whose bond breaks at once moves exactly as if never bonded.
+      s.intact[k] = 0;
+      bonds.broke[k] = tensile_ratio >= shear_ratio ? 1 : 2;
+      bonds.force_b[k].setZero();
+      bonds.torque_a[k].setZero();
+      bonds.torque_b[k].setZero();
+      any_broke = true;
+      continue;
+    }
+    const Vec3 f = fn * n + fs;  // on b (Eq 2-27)
+    const Vec3 m = mn * n + ms;  // on b (Eq 2-28)
+    bonds.force_b[k] = f;
+    bonds.torque_b[k] = m + (xc - xb).cross(f);
+    bonds.torque_a[k] = -m - (xc - xa).cross(f);
+  }
+  if (any_broke) {
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      if (!bonds.broke[k]) continue;
+      --bonds.intact;
+      const BondDisc disc = bondDisc(s.radius[k]);
+      BondBreak e;
+      e.time = time;
+      e.step = step;
+      e.bond = static_cast<std::uint32_t>(k);
+      e.a = s.a[k];
+      e.b = s.b[k];
+      e.mode = bonds.broke[k] == 1 ? BondFailureMode::Tensile : BondFailureMode::Shear;
+      const BondStress stress = bondStress(disc, s.normal_force[k], s.shear_force[k],
+                                           s.twist_moment[k], s.bend_moment[k]);
+      e.tensile_stress = stress.tensile;
+      e.shear_stress = stress.shear;
+      bonds.breaks.push_back(e);
+    }
+  }
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+#pragma omp parallel for schedule(static) num_threads(teamSize())
+  for (std::ptrdiff_t ii = 0; ii < n; ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    for (std::uint32_t e = bonds.ball_offset[i]; e < bonds.ball_offset[i + 1]; ++e) {
+      const std::uint32_t k = bonds.ball_end[e] >> 1;
+      if (!s.intact[k]) continue;
+      if (bonds.ball_end[e] & 1u) {
+        scratch.acc_force[i] += bonds.force_b[k];
+        scratch.acc_torque[i] += bonds.torque_b[k];
+      } else {
+        scratch.acc_force[i] -= bonds.force_b[k];
+        scratch.acc_torque[i] += bonds.torque_a[k];
+      }
+    }
+  }
+}
+
+/// The rows of bond ends by ball (ascending bond index in each row), and the
+/// per-bond scratch.
+void World::Impl::indexBonds() {
+  const BondState& s = bonds.state;
+  const std::size_t n = p.size();
+  bonds.ball_offset.assign(n + 1, 0);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    ++bonds.ball_offset[s.a[k] + 1];
+    ++bonds.ball_offset[s.b[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) bonds.ball_offset[i + 1] += bonds.ball_offset[i];
+  bonds.ball_end.assign(2 * s.size(), 0);
+  std::vector<std::uint32_t> fill(bonds.ball_offset.begin(), bonds.ball_offset.end() - 1);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    bonds.ball_end[fill[s.a[k]]++] = static_cast<std::uint32_t>(2 * k);
+    bonds.ball_end[fill[s.b[k]]++] = static_cast<std::uint32_t>(2 * k + 1);
+  }
+  bonds.force_b.assign(s.size(), Vec3::Zero());
+  bonds.torque_a.assign(s.size(), Vec3::Zero());
+  bonds.torque_b.assign(s.size(), Vec3::Zero());
+  bonds.broke.assign(s.size(), 0);
+  bonds.intact = 0;
+  for (std::uint8_t f : s.intact) bonds.intact += f ? 1 : 0;
+}
+
+void World::Impl::installBonds(const std::vector<BondSpec>& specs) {
+  BondState& s = bonds.state;
+  const ParallelBondModel& bm = model.bonds;
+  for (const BondSpec& b : specs) {
+    const double ra = p.radius[b.a], rb = p.radius[b.b];
+    const Vec3 d = p.position[b.b] - p.position[b.a];
+    s.a.push_back(b.a);
+    s.b.push_back(b.b);
+    s.radius.push_back(bm.radius_multiplier * std::min(ra, rb));  // Eq 2-35
+    s.tensile_strength.push_back(b.tensile_strength);
+    s.shear_strength.push_back(b.shear_strength);
+    s.intact.push_back(1);
+    s.normal.push_back(d.norm() > 0 ? Vec3(d.normalized()) : Vec3(Vec3::UnitZ()));
+    s.normal_force.push_back(0.0);
+    s.shear_force.push_back(Vec3::Zero());
+    s.twist_moment.push_back(0.0);
+    s.bend_moment.push_back(Vec3::Zero());
+  }
+  indexBonds();
+}
+
+/// Elastic energy of the intact bonds: each spring's F^2 / (2 k).
+double World::Impl::bondEnergy() const {
+  const BondState& s = bonds.state;
+  const double kn = model.bonds.normal_stiffness, ks = model.bonds.shear_stiffness;
+  double e = 0.0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (!s.intact[k]) continue;
+    const BondDisc d = bondDisc(s.radius[k]);
+    e += 0.5 * s.normal_force[k] * s.normal_force[k] / (kn * d.area);
+    e += 0.5 * s.bend_moment[k].squaredNorm() / (kn * d.inertia);
+    if (ks > 0) {
+      e += 0.5 * s.shear_force[k].squaredNorm() / (ks * d.area);
+      e += 0.5 * s.twist_moment[k] * s.twist_moment[k] / (ks * d.polar);
+    }
+  }
+  return e;
+}
+
+/// The intact bonds' translational springs for the contact-network step check.
+void World::Impl::bondSprings(std::vector<NetworkSpring>& out) const {
+  const BondState& s = bonds.state;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (!s.intact[k]) continue;
+    const BondDisc d = bondDisc(s.radius[k]);
+    const std::uint32_t a = s.a[k], b = s.b[k];
+    const Vec3 n = s.normal[k];
+    const double gap = (p.position[b] - p.position[a]).norm() - p.radius[a] - p.radius[b];
+    NetworkSpring spring;
+    spring.a = a;
+    spring.b = b;
+    spring.normal = n;
+    spring.point = p.position[a] + n * (p.radius[a] + 0.5 * gap);
+    spring.kn = model.bonds.normal_stiffness * d.area;
+    spring.ks = model.bonds.shear_stiffness * d.area;
+    out.push_back(spring);
+  }
+}
+
+}  // namespace rocklab::sim
