@@ -9,9 +9,11 @@
 //   2. groups of four neighbouring spheres = the cells of the regular (power)
 //      triangulation of the centres, weights r² (CGAL; Delaunay for equal spheres).
 //      The reference's own search (smallest tetrahedron among the neighbours within
-//      4 r_max of a random sphere) finds a subset of these groups and leaves the
-//      flat ones to an unstated rule; the triangulation has every void exactly once.
-//   3. the inner tangent sphere of each group (innerTangentSphere);
+//      4 r_max of a random sphere) takes one group per sphere, a subset of these,
+//      and leaves flat groups to an unstated rule; the triangulation has every void
+//      exactly once, so it fills more of them.
+//   3. the inner tangent sphere of each group (innerTangentSphere); its centre
+//      must lie inside the bounding sphere;
 //   4. condition 1 r >= r_min, else rejected; condition 2 (no overlap with any
 //      sphere, hash grid; overlaps up to 1e-6 of the smaller radius are contacts)
 //      and r <= r_max and inside the bounding sphere → placed as computed; when
@@ -26,10 +28,9 @@
 // places nothing; cells already tried (same four spheres) are not tried again: a
 // placement only adds obstacles, so a rejected void does not reopen (bar the rare
 // grown sphere that touched nothing before), and each pass costs only its new cells.
-// Within a pass the
-// cells are visited in a seeded random order (the reference picks spheres at
-// random; the seed gives different agglomerates from one pack). Deterministic for a
-// given input and seed.
+// Within a pass the cells are visited in a seeded random order (the reference picks
+// spheres at random; the seed gives different agglomerates from one pack).
+// Deterministic for a given input and seed.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
