@@ -6,6 +6,8 @@ find_package(nlohmann_json 3 REQUIRED)           # nlohmann_json::nlohmann_json
 find_package(tomlplusplus REQUIRED)              # tomlplusplus::tomlplusplus
 find_package(fmt REQUIRED)                       # fmt::fmt
 find_package(assimp REQUIRED)                    # assimp::assimp
+# Header-only (needs GMP/MPFR); geometry links it PRIVATE: it never appears in a public header.
+find_package(CGAL REQUIRED)                      # CGAL::CGAL (regular triangulation for agglomerates)
 # ${OpenCV_LIBS}: plots, frames (imgcodecs), movies (videoio), projectPoints/calibration (calib3d)
 find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs videoio calib3d)
 # List the VTK components: without them find_package(VTK) looks for Qt5 and fails.

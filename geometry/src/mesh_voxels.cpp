@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "z_ray_crossing.h"
+
 namespace rocklab::geometry {
 
 namespace {
@@ -71,8 +73,6 @@ InsideGrid voxelizeInside(const TriangleMesh& mesh, int cells_across) {
   std::vector<std::vector<std::pair<double, int>>> cross(static_cast<std::size_t>(g.n[0]) * g.n[1]);
   for (const auto& t : mesh.triangles) {
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-    const double nz = (b - a).cross(c - a).z();
-    if (nz == 0) continue;  // vertical triangle: the ray runs along it
     const double xlo = std::min({a.x(), b.x(), c.x()}), xhi = std::max({a.x(), b.x(), c.x()});
     const double ylo = std::min({a.y(), b.y(), c.y()}), yhi = std::max({a.y(), b.y(), c.y()});
     const int i0 = std::max(0, static_cast<int>(std::ceil((xlo - g.origin.x()) / g.h)));
@@ -81,15 +81,9 @@ InsideGrid voxelizeInside(const TriangleMesh& mesh, int cells_across) {
     const int j1 = std::min(g.n[1] - 1, static_cast<int>(std::floor((yhi - g.origin.y()) / g.h)));
     for (int i = i0; i <= i1; ++i)
       for (int j = j0; j <= j1; ++j) {
-        const double px = g.origin.x() + i * g.h, py = g.origin.y() + j * g.h;
-        // Barycentric coordinates in the xy projection.
-        const double w0 = (b.x() - px) * (c.y() - py) - (c.x() - px) * (b.y() - py);
-        const double w1 = (c.x() - px) * (a.y() - py) - (a.x() - px) * (c.y() - py);
-        const double w2 = (a.x() - px) * (b.y() - py) - (b.x() - px) * (a.y() - py);
-        const bool in = (w0 >= 0 && w1 >= 0 && w2 >= 0) || (w0 <= 0 && w1 <= 0 && w2 <= 0);
-        if (!in) continue;
-        const double z = (w0 * a.z() + w1 * b.z() + w2 * c.z()) / (w0 + w1 + w2);
-        cross[static_cast<std::size_t>(i) * g.n[1] + j].push_back({z, nz < 0 ? 1 : -1});
+        const auto hit =
+            detail::zRayCrossing(a, b, c, g.origin.x() + i * g.h, g.origin.y() + j * g.h);
+        if (hit) cross[static_cast<std::size_t>(i) * g.n[1] + j].push_back({hit->z, hit->sign});
       }
   }
   for (int i = 0; i < g.n[0]; ++i)
@@ -106,6 +100,45 @@ InsideGrid voxelizeInside(const TriangleMesh& mesh, int cells_across) {
       }
     }
   return g;
+}
+
+std::vector<bool> pointsInside(const TriangleMesh& mesh, const std::vector<Vec3>& points) {
+  std::vector<bool> inside(points.size(), false);
+  if (mesh.triangles.empty() || points.empty()) return inside;
+  // Triangles binned by their xy bounding boxes on about sqrt(nt) x sqrt(nt) columns.
+  const AABB box = mesh.bounds();
+  const int bins =
+      std::max(1, static_cast<int>(std::sqrt(static_cast<double>(mesh.triangles.size()))));
+  const double wx = std::max((box.hi.x() - box.lo.x()) / bins, 1e-300);
+  const double wy = std::max((box.hi.y() - box.lo.y()) / bins, 1e-300);
+  auto column = [&](double v, double lo, double w) {
+    return std::clamp(static_cast<int>(std::floor((v - lo) / w)), 0, bins - 1);
+  };
+  std::vector<std::vector<std::uint32_t>> bin(static_cast<std::size_t>(bins) * bins);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
+    const int i0 = column(std::min({a.x(), b.x(), c.x()}), box.lo.x(), wx);
+    const int i1 = column(std::max({a.x(), b.x(), c.x()}), box.lo.x(), wx);
+    const int j0 = column(std::min({a.y(), b.y(), c.y()}), box.lo.y(), wy);
+    const int j1 = column(std::max({a.y(), b.y(), c.y()}), box.lo.y(), wy);
+    for (int i = i0; i <= i1; ++i)
+      for (int j = j0; j <= j1; ++j) bin[static_cast<std::size_t>(i) * bins + j].push_back(t);
+  }
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    const Vec3& p = points[q];
+    if (box.distance(p) > 0) continue;
+    int winding = 0;
+    for (std::uint32_t t : bin[static_cast<std::size_t>(column(p.x(), box.lo.x(), wx)) * bins +
+                               column(p.y(), box.lo.y(), wy)]) {
+      const auto& tri = mesh.triangles[t];
+      const auto hit = detail::zRayCrossing(mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                            mesh.vertices[tri[2]], p.x(), p.y());
+      if (hit && hit->z < p.z()) winding += hit->sign;
+    }
+    inside[q] = winding > 0;
+  }
+  return inside;
 }
 
 void computeDistance(InsideGrid& g) {

@@ -1,7 +1,8 @@
 #pragma once
-// Which points of a regular grid lie inside a closed mesh, and how far each inside
-// point is from the outside (a distance transform). Both clump generators and the
-// coverage bookkeeping of their greedy selection work on this grid.
+// Which points of a regular grid (or any given points) lie inside a closed mesh, and
+// how far each inside grid point is from the outside (a distance transform). Both
+// clump generators and the coverage bookkeeping of their greedy selection work on
+// this grid; carving agglomerates asks for single points.
 //
 // Inside test: for every (x, y) column a ray along +z meets the triangles whose
 // projection contains the column; entering crossings (triangle facing −z) add one,
@@ -10,7 +11,8 @@
 // cost is about (triangles + columns crossed). The columns are offset from the cell
 // grid's symmetric positions by small irrational fractions of a cell so that a ray
 // does not run exactly through the shared edge of two triangles (a cube's diagonal,
-// say), where it would be counted twice or not at all.
+// say); where one does anyway (given points), the crossing test's tie rule counts the
+// edge once (src/z_ray_crossing.h).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -36,6 +38,11 @@ struct InsideGrid {
 /// Grid of `cells_across` cells along the mesh's largest extent, one empty cell
 /// of margin on every side. The mesh must be closed and outward (checkAndRepairMesh).
 InsideGrid voxelizeInside(const TriangleMesh& mesh, int cells_across);
+
+/// For every point, whether it lies inside the closed, outward mesh (the same z-ray
+/// crossing count as voxelizeInside; triangles binned to xy columns). Points on the
+/// surface may go either way.
+std::vector<bool> pointsInside(const TriangleMesh& mesh, const std::vector<Vec3>& points);
 
 /// Fills grid.distance: Euclidean distance from each inside cell centre to the
 /// nearest outside cell centre minus h/2 (≈ distance to the surface, ± h/2);
