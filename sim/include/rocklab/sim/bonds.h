@@ -105,4 +105,9 @@ struct BondStress {
 BondStress bondStress(const BondDisc& disc, double normal_force, const geometry::Vec3& shear_force,
                       double twist_moment, const geometry::Vec3& bend_moment);
 
+/// Fragments: the balls joined by intact bonds (directly or through others).
+/// Returns one label per ball, 0, 1, 2, ... in the order of each fragment's
+/// lowest ball index; an unbonded ball is a fragment of its own.
+std::vector<std::uint32_t> bondedClusters(std::size_t ball_count, const BondState& bonds);
+
 }  // namespace rocklab::sim

@@ -129,6 +129,12 @@ class World {
   /// Every breakage since this World was built, in the order they happened
   /// (within a step by bond index).
   const std::vector<BondBreak>& bondBreaks() const;
+  /// Average stress of every ball (Pa, compression positive, dem-models §11):
+  /// -(1/V) sum over its contacts and intact bonds of sym(x_c (x) F_c), with
+  /// V = 4/3 pi R^3, x_c from the centre to the contact point and F_c the
+  /// elastic contact force (normal and shear springs, no dashpots) or the bond
+  /// force of the last step. Computed on demand (not in the step).
+  std::vector<geometry::Mat3> particleStress() const;
 
   /// Adds forces other than contacts (force_contribution.h); called in the
   /// `extra forces` stage in the order added. A world with contributions no

@@ -1,0 +1,96 @@
+// The average stress of each ball (World::particleStress, dem-models.md §11)
+// and its principal values (particle_stress.h).
+#include "rocklab/sim/particle_stress.h"
+
+#include <Eigen/Eigenvalues>
+#include <numbers>
+
+#include "world_impl.h"
+
+namespace rocklab::sim {
+
+using geometry::Mat3;
+
+PrincipalStresses principalStresses(const Mat3& stress) {
+  const Mat3 symmetric = 0.5 * (stress + stress.transpose());
+  const Eigen::SelfAdjointEigenSolver<Mat3> solver(symmetric);
+  PrincipalStresses s;  // the solver sorts ascending
+  s.minor = solver.eigenvalues()[0];
+  s.intermediate = solver.eigenvalues()[1];
+  s.major = solver.eigenvalues()[2];
+  s.minor_direction = solver.eigenvectors().col(0);
+  return s;
+}
+
+double octahedralShearStress(const PrincipalStresses& s) {
+  const double a = s.major - s.intermediate, b = s.intermediate - s.minor, c = s.minor - s.major;
+  return std::sqrt(a * a + b * b + c * c) / 3.0;  // Eq 3-15 / 6-10 [R]
+}
+
+namespace {
+
+/// -sym(x (x) F): a force F on the ball at x from its centre, compression positive.
+inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
+  const Mat3 m = x * f.transpose();
+  return -0.5 * (m + m.transpose());
+}
+
+}  // namespace
+
+template <class Law>
+void World::Impl::contactStress(std::vector<Mat3>& sum) const {
+  const Impl& w = *this;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::uint32_t k = w.nb.pairs.row_offset[i]; k < w.nb.pairs.row_offset[i + 1]; ++k) {
+      if (!w.history.pair_touch[k]) continue;
+      const std::uint32_t j = w.nb.pairs.partner[k];
+      ContactPoint touch;
+      if (!ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch)) continue;
+      const double overlap = w.pairOverlap(touch, k);
+      if (overlap <= 0) continue;
+      double secant, tangent;
+      Law::normal(w.pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), secant,
+                  tangent);
+      const Vec3 on_i = w.history.pair_shear[k] - secant * overlap * touch.normal;
+      sum[i] += stressMoment(touch.point - p.position[i], on_i);
+      sum[j] += stressMoment(touch.point - p.position[j], -on_i);
+    }
+    for (std::uint32_t c = w.nb.wall_offset[i]; c < w.nb.wall_offset[i + 1]; ++c) {
+      if (!w.history.wall_touch[c]) continue;
+      const std::uint32_t wk = w.nb.wall_index[c];
+      ContactPoint touch;
+      if (!ballWallTouch(w.walls[wk], w.model.walls[wk], p.position[i], p.radius[i], touch))
+        continue;
+      const double overlap = w.wallOverlap(touch, c);
+      if (overlap <= 0) continue;
+      double secant, tangent;
+      Law::normal(w.wallProps(i, wk), overlap, p.radius[i], secant, tangent);
+      const Vec3 on_i = w.history.wall_shear[c] - secant * overlap * touch.normal;
+      sum[i] += stressMoment(touch.point - p.position[i], on_i);
+    }
+  }
+}
+
+std::vector<Mat3> World::particleStress() const {
+  const Impl& w = *impl_;
+  const ParticleState& p = w.p;
+  std::vector<Mat3> sum(p.size(), Mat3::Zero());
+  if (w.model.contact.law == ContactLaw::Linear)
+    w.contactStress<detail::LinearLaw>(sum);
+  else
+    w.contactStress<detail::HertzMindlinLaw>(sum);
+  const BondState& b = w.bonds.state;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    if (!b.intact[k]) continue;
+    const std::uint32_t i = b.a[k], j = b.b[k];
+    const double gap = (p.position[j] - p.position[i]).norm() - p.radius[i] - p.radius[j];
+    const Vec3 point = p.position[i] + b.normal[k] * (p.radius[i] + 0.5 * gap);
+    sum[j] += stressMoment(point - p.position[j], w.bonds.force_b[k]);
+    sum[i] += stressMoment(point - p.position[i], -w.bonds.force_b[k]);
+  }
+  for (std::size_t i = 0; i < p.size(); ++i)
+    sum[i] /= 4.0 / 3.0 * std::numbers::pi * std::pow(p.radius[i], 3);
+  return sum;
+}
+
+}  // namespace rocklab::sim
