@@ -455,10 +455,10 @@ void readExperiment(TableReader& root, Scene& scene) {
   std::vector<std::string> types;
   for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
   scene.experiment_type = t->requiredString("type", types);
-  auto settings = std::make_shared<ExperimentSettings>();
-  settings->check_interval = t->number("check_interval", settings->check_interval, Range::positive());
-  // The driver reads and checks the keys of its type (drivers/registry.cpp).
-  findExperimentDriver(scene.experiment_type)->read_settings(*t, SettingsContext{scene.model, scene.cameras}, *settings);
+  const double check_interval = t->number("check_interval", ExperimentSettings{}.check_interval, Range::positive());
+  // The driver reads and checks the keys of its type into its settings (drivers/registry.cpp).
+  auto settings = findExperimentDriver(scene.experiment_type)->read_settings(*t, SettingsContext{scene.model, scene.cameras});
+  settings->check_interval = check_interval;
   t->finish();
   scene.experiment = std::move(settings);
 }
