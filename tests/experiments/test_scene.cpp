@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "drivers/chute_experiment.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/sweep.h"
-#include "drivers/experiment_settings.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
@@ -48,27 +48,34 @@ TEST_CASE("a minimal scene loads with defaults", "[scene]") {
 
 TEST_CASE("unknown key: file - line and the known keys", "[scene]") {
   const std::string msg = errorOf(kMinimal + "\n[timestep]\nsaftey_factor = 0.3\n");
-  CHECK_THAT(msg, Contains("bad.toml:17: unknown key 'timestep.saftey_factor'") && Contains("safety_factor"));
+  CHECK_THAT(msg, Contains("bad.toml:17: unknown key 'timestep.saftey_factor'") &&
+                      Contains("safety_factor"));
 }
 
 TEST_CASE("wrong type: names the key - the value and the allowed values", "[scene]") {
   CHECK_THAT(errorOf(kMinimal + "\n[timestep]\nsafety_factor = \"fast\"\n"),
-             Contains("bad.toml:17: key 'timestep.safety_factor' = \"fast\": expected a number") && Contains("(0, 1]"));
-  CHECK_THAT(errorOf(kMinimal + "\n[contact]\nlaw = \"hooke\"\n"),
-             Contains("key 'contact.law' = \"hooke\": not allowed; allowed: \"linear\", \"hertz_mindlin\""));
+             Contains("bad.toml:17: key 'timestep.safety_factor' = \"fast\": expected a number") &&
+                 Contains("(0, 1]"));
+  CHECK_THAT(
+      errorOf(kMinimal + "\n[contact]\nlaw = \"hooke\"\n"),
+      Contains(
+          "key 'contact.law' = \"hooke\": not allowed; allowed: \"linear\", \"hertz_mindlin\""));
 }
 
 TEST_CASE("out of range values are refused with the range", "[scene]") {
   CHECK_THAT(errorOf(kMinimal + "\n[contact]\ndamping_normal = 1.5\n"),
              Contains("key 'contact.damping_normal' = 1.5: out of range; allowed: [0, 1)"));
   CHECK_THAT(errorOf(kMinimal, {"materials.rock.density=-3"}),
-             Contains("--set materials.rock.density=-3: key 'materials.rock.density' = -3: out of range; allowed: > 0"));
+             Contains("--set materials.rock.density=-3: key 'materials.rock.density' = -3: out of "
+                      "range; allowed: > 0"));
 }
 
 TEST_CASE("missing pieces and files", "[scene]") {
-  CHECK_THAT(errorOf("[scene]\nname = \"x\"\nend_time = 1\n"), Contains("key 'materials'") && Contains("missing"));
-  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"plane\"\nmaterial = \"rock\"\nnormal = [0,0,1]\n"),
-             Contains("key 'walls.0.point'") && Contains("missing"));
+  CHECK_THAT(errorOf("[scene]\nname = \"x\"\nend_time = 1\n"),
+             Contains("key 'materials'") && Contains("missing"));
+  CHECK_THAT(
+      errorOf(kMinimal + "\n[[walls]]\ntype = \"plane\"\nmaterial = \"rock\"\nnormal = [0,0,1]\n"),
+      Contains("key 'walls.0.point'") && Contains("missing"));
   CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"steel\"\n"),
              Contains("key 'walls.0.material' = \"steel\": not allowed; allowed: \"rock\""));
   try {
@@ -81,14 +88,18 @@ TEST_CASE("missing pieces and files", "[scene]") {
 }
 
 TEST_CASE("option set overrides: values - array indices and bad paths", "[scene]") {
-  const Scene s = loadSceneText(kMinimal, "t.toml", {"particles.0.radius=0.02", "scene.end_time=2", "gravity.vector=[0,0,-1]"});
+  const Scene s =
+      loadSceneText(kMinimal, "t.toml",
+                    {"particles.0.radius=0.02", "scene.end_time=2", "gravity.vector=[0,0,-1]"});
   CHECK(s.spheres[0].radius == 0.02);
   CHECK(s.run.end_time == 2.0);
   CHECK(s.model.gravity.z() == -1.0);
   CHECK_THAT(s.text, Contains("end_time = 2"));  // the effective scene is what gets stored
-  CHECK_THAT(errorOf(kMinimal, {"particles.3.radius=1"}), Contains("index 3 is beyond the 1 entries"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.3.radius=1"}),
+             Contains("index 3 is beyond the 1 entries"));
   CHECK_THAT(errorOf(kMinimal, {"noequals"}), Contains("expected key=value"));
-  CHECK_THAT(errorOf(kMinimal, {"scene.end_tim=3"}), Contains("--set scene.end_tim=3: unknown key 'scene.end_tim'"));
+  CHECK_THAT(errorOf(kMinimal, {"scene.end_tim=3"}),
+             Contains("--set scene.end_tim=3: unknown key 'scene.end_tim'"));
 }
 
 TEST_CASE("every built-in scene loads", "[scene]") {
@@ -108,9 +119,11 @@ TEST_CASE("mesh walls from an STL file (assimp) and inline triangles", "[scene]"
   {
     std::ofstream stl(dir / "floor.stl");
     stl << "solid floor\n"
-           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 0 0\n   vertex 1000 1000 0\n"
+           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 0 0\n   vertex 1000 "
+           "1000 0\n"
            "  endloop\n endfacet\n"
-           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 1000 0\n   vertex 0 1000 0\n"
+           " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1000 1000 0\n   vertex 0 "
+           "1000 0\n"
            "  endloop\n endfacet\nendsolid floor\n";
   }
   const std::string walls = R"(
@@ -132,7 +145,8 @@ triangles = [[0, 1, 2]]
   CHECK(s.model.walls[0].mesh.vertices.size() == 4);  // welded
   CHECK(s.model.walls[0].mesh.bounds().hi.x() == Approx(1.0));
   CHECK(s.model.walls[1].mesh.triangleCount() == 1);
-  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"missing.stl\"\n"),
+  CHECK_THAT(errorOf(kMinimal +
+                     "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"missing.stl\"\n"),
              Contains("key 'walls.0.file' = \"missing.stl\": cannot read mesh"));
   std::filesystem::remove_all(dir);
 }
@@ -141,11 +155,12 @@ TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
   const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/";
   const Scene base = loadScene(dir + "chute-30-clumps.toml");
   const Scene steep = loadScene(dir + "chute-33-clumps.toml");
-  CHECK(steep.experiment->inclination_deg == 33.0);
+  CHECK(settingsOf<ChuteSettings>(steep).inclination_deg == 33.0);
   CHECK(steep.run.name == "chute-33-clumps");
   CHECK(steep.clumps.size() == base.clumps.size());
   CHECK(steep.model.walls.size() == base.model.walls.size());
-  CHECK(steep.experiment->marker_columns == base.experiment->marker_columns);
+  CHECK(settingsOf<ChuteSettings>(steep).marker_columns ==
+        settingsOf<ChuteSettings>(base).marker_columns);
   const Scene spheres = loadScene(dir + "chute-30-spheres.toml");  // [[particles]] replaced whole
   CHECK(spheres.clumps.empty());
   CHECK(spheres.spheres.size() == 1680);
@@ -160,8 +175,9 @@ TEST_CASE("set overrides address an array entry by its name", "[scene]") {
   REQUIRE(top.name == "top");
   CHECK(top.vertices[0].z() == Approx(0.04));
   CHECK(top.vertices[1].z() == Approx(0.04 + 0.65 * 0.5));
-  CHECK_THROWS_WITH(loadScene(file, {"walls.nosuchwall.angle_deg=3"}),
-                    Contains("'nosuchwall' must be an index into the array or the name of one of its entries"));
+  CHECK_THROWS_WITH(
+      loadScene(file, {"walls.nosuchwall.angle_deg=3"}),
+      Contains("'nosuchwall' must be an index into the array or the name of one of its entries"));
 }
 
 TEST_CASE("vary values keep commas inside brackets", "[scene]") {
@@ -195,7 +211,8 @@ count = 5
 region_min = [0.1, 0.1, 0.1]
 region_max = [0.2, 0.2, 0.2]
 )";
-  const Scene s = loadSceneText(text, "clumps.toml", {}, std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes");
+  const Scene s =
+      loadSceneText(text, "clumps.toml", {}, std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes");
   REQUIRE(s.clumps.size() == 6);
   REQUIRE(s.clump_shapes.size() == 2);
   // Eq 4-2 sizing: the clump's mass is that of a 20 mm sphere of the density.
@@ -221,23 +238,30 @@ TEST_CASE("camera keys are checked and a scene without cameras has none", "[scen
   CHECK(s.wall_looks.size() == s.model.walls.size());
   CHECK(s.wall_looks[1].opacity == Approx(0.15));  // the camera-side Perspex
   CHECK(loadScene(std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/drop.toml").cameras.empty());
-  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.resolution=[960]"}), Contains("cameras.0.resolution"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.resolution=[960]"}),
+                    Contains("cameras.0.resolution"));
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.fov_deg=200"}), Contains("cameras.0.fov_deg"));
-  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.eye=[0.27, 0.15, 0.05]"}), Contains("cameras.0.up"));
-  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.motion_blur=true"}), Contains("needs exposure > 0 s"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.eye=[0.27, 0.15, 0.05]"}),
+                    Contains("cameras.0.up"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.motion_blur=true"}),
+                    Contains("needs exposure > 0 s"));
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.lens=1"}), Contains("cameras.0.lens"));
 }
 
-TEST_CASE("contact.stiffness_scale scales every material's stiffness - and spaces around = in --set", "[scene]") {
+TEST_CASE(
+    "contact.stiffness_scale scales every material's stiffness - and spaces around = in --set",
+    "[scene]") {
   const Scene s = loadSceneText(kMinimal, "min.toml", {"contact.stiffness_scale = 0.01"});
   CHECK(s.model.materials[0].kn == Approx(1e5));
   CHECK(s.model.materials[0].ks == Approx(1e5));
-  CHECK_THAT(errorOf(kMinimal, {"contact.stiffness_scale=0"}), Contains("stiffness_scale") && Contains("> 0"));
+  CHECK_THAT(errorOf(kMinimal, {"contact.stiffness_scale=0"}),
+             Contains("stiffness_scale") && Contains("> 0"));
 }
 
 TEST_CASE("watchdog network keys and relaxation.steps are read and range-checked", "[scene]") {
-  const Scene s = loadSceneText(kMinimal, "t.toml",
-                                {"relaxation.steps=5000", "watchdog.network_iterations=0", "watchdog.network_interval=250"});
+  const Scene s = loadSceneText(
+      kMinimal, "t.toml",
+      {"relaxation.steps=5000", "watchdog.network_iterations=0", "watchdog.network_interval=250"});
   CHECK(s.model.relaxation.steps == 5000);
   CHECK(s.model.watchdog.network_iterations == 0);
   CHECK(s.model.watchdog.network_interval == 250);

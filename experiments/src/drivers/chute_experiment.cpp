@@ -13,6 +13,8 @@
 //            when none left for jam_time (jammed).
 // Chute frame: outlet at x = 0, feed end at x = length, base z = 0, camera wall
 // y = 0; the tilt turns gravity instead of the geometry (§c DEM 4).
+#include "drivers/chute_experiment.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -22,13 +24,11 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "drivers/experiment.h"
-#include "drivers/registry.h"
-#include "drivers/settle.h"
-#include "camera/camera_calibration.h"
-#include "camera/camera_recorder.h"
 #include "analysis/marker_tracking.h"
 #include "analysis/plot.h"
+#include "camera/camera_calibration.h"
+#include "camera/camera_recorder.h"
+#include "drivers/settle.h"
 #include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
 
@@ -40,46 +40,60 @@ using geometry::Vec3;
 
 struct Marker {
   std::uint64_t id = 0;
-  int column = 0;       // 1 = nearest the outlet
-  int row = 0;          // 1 = lowest
+  int column = 0;              // 1 = nearest the outlet
+  int row = 0;                 // 1 = lowest
   Vec3 target = Vec3::Zero();  // m, the lab position it stands for
   Vec3 start = Vec3::Zero();   // m, position when the gate opened
   double last_travel = 0.0, last_time = 0.0;
-  double onset_time = std::numeric_limits<double>::quiet_NaN();   // s after gate opening: travel reached kOnset
-  double travel_time = std::numeric_limits<double>::quiet_NaN();  // s after gate opening: travel reached measure_distance
-  double velocity = std::numeric_limits<double>::quiet_NaN();     // m/s over the first measure_distance of its own motion
-  double velocity_from_gate = std::numeric_limits<double>::quiet_NaN();  // m/s, measure_distance / travel_time
+  double onset_time =
+      std::numeric_limits<double>::quiet_NaN();  // s after gate opening: travel reached kOnset
+  double travel_time = std::numeric_limits<double>::quiet_NaN();  // s after gate opening: travel
+                                                                  // reached measure_distance
+  double velocity = std::numeric_limits<double>::quiet_NaN();     // m/s over the first
+                                                               // measure_distance of its own motion
+  double velocity_from_gate =
+      std::numeric_limits<double>::quiet_NaN();  // m/s, measure_distance / travel_time
 };
 
 constexpr double kOnset = 0.002;  // m of travel that marks the start of a marker's motion
 
-nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json orNull(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 class ChuteExperiment final : public Experiment {
  public:
-  explicit ChuteExperiment(const Scene& scene) : e_(*scene.experiment), g_(scene.model.gravity.norm()), settle_(*scene.experiment) {
+  explicit ChuteExperiment(const Scene& scene)
+      : e_(settingsOf<ChuteSettings>(scene)), g_(scene.model.gravity.norm()), settle_(e_.settle) {
     for (const CameraSettings& c : scene.cameras)
       if (c.name == e_.track_camera) {
         tracking_ = std::make_unique<MarkerTracking>(c.camera, kOnset, e_.measure_distance);
         track_settings_ = c;
       }
     // Size of a marker pebble: the clump's equivalent sphere, or the largest sphere.
-    if (!scene.clump_shapes.empty()) marker_radius_ = 0.5 * scene.clump_shapes.front().equivalent_diameter;
+    if (!scene.clump_shapes.empty())
+      marker_radius_ = 0.5 * scene.clump_shapes.front().equivalent_diameter;
     for (const auto& s : scene.spheres) marker_radius_ = std::max(marker_radius_, s.radius);
   }
 
-  std::string trackingCamera() const override { return tracking_ ? e_.track_camera : std::string(); }  // read once at start
+  std::string trackingCamera() const override {
+    return tracking_ ? e_.track_camera : std::string();
+  }  // read once at start
   void cameraFrame(std::uint64_t frame, double time, const cv::Mat& raw) override {
-    if (tracking_ && !markers_.empty()) tracking_->addFrame(frame, time, raw);  // red exists once markers are chosen
+    if (tracking_ && !markers_.empty())
+      tracking_->addFrame(frame, time, raw);  // red exists once markers are chosen
   }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     if (phase_ == Phase::Start) {
-      every_ = static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
+      every_ =
+          static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
       switchPhase(world, ctx, [&](sim::Model& m) {
         m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
         m.gravity_changes.clear();  // the experiment owns gravity
-        if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = std::numeric_limits<double>::max();  // until placed
+        if (!e_.top_wall.empty())
+          m.walls[wallIndex(m, e_.top_wall)].active_from =
+              std::numeric_limits<double>::max();  // until placed
       });
       phase_ = Phase::Deposit;
       bodies_total_ = indexBodies(world->particles()).size();
@@ -104,16 +118,25 @@ class ChuteExperiment final : public Experiment {
     s << std::setprecision(3);
     switch (phase_) {
       case Phase::Start:
-      case Phase::Deposit: s << "deposit, max speed " << settle_.maxSpeed() << " m/s"; break;
-      case Phase::Tilt: s << "tilt"; break;
-      case Phase::Flow: s << "flow, " << (bodies_total_ - discharged_count_) << " bodies in the chute"; break;
-      case Phase::Done: s << "done"; break;
+      case Phase::Deposit:
+        s << "deposit, max speed " << settle_.maxSpeed() << " m/s";
+        break;
+      case Phase::Tilt:
+        s << "tilt";
+        break;
+      case Phase::Flow:
+        s << "flow, " << (bodies_total_ - discharged_count_) << " bodies in the chute";
+        break;
+      case Phase::Done:
+        s << "done";
+        break;
     }
     return s.str();
   }
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override;
-  nlohmann::json reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir, std::ostream& log) const;
+  nlohmann::json reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir,
+                                std::ostream& log) const;
 
   std::unordered_set<std::uint64_t> markerBodies() const override {
     std::unordered_set<std::uint64_t> ids;
@@ -156,7 +179,8 @@ class ChuteExperiment final : public Experiment {
     switchPhase(
         world, ctx,
         [&](sim::Model& m) {
-          for (const std::string& name : e_.temporary_walls) m.walls[wallIndex(m, name)].active_until = t;
+          for (const std::string& name : e_.temporary_walls)
+            m.walls[wallIndex(m, name)].active_until = t;
           if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = t;
           m.gravity = tiltedGravity(g_, e_.inclination_deg, e_.rotate_gravity);
         },
@@ -179,8 +203,9 @@ class ChuteExperiment final : public Experiment {
     if (!tracking_) return;
     try {
       if (e_.calibration_photos > 0) {
-        const WallCalibration cal = calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_),
-                                                    Vec3::Zero(), -Vec3::UnitY(), e_.calibration_photos);
+        const WallCalibration cal =
+            calibrateOnWall(track_settings_.camera, renderOptionsFor(track_settings_), Vec3::Zero(),
+                            -Vec3::UnitY(), e_.calibration_photos);
         tracking_->setCamera(cal.camera);
         calibration_report_ = cal.report;
       }
@@ -204,7 +229,8 @@ class ChuteExperiment final : public Experiment {
     std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
     const double median_radius = r.empty() ? 0.0 : r[r.size() / 2];
     const bool at_wall = e_.marker_y <= 0;
-    std::unordered_map<std::uint64_t, double> wall_gap;  // body id -> smallest y - radius of its balls
+    std::unordered_map<std::uint64_t, double>
+        wall_gap;  // body id -> smallest y - radius of its balls
     for (std::size_t i = 0; i < p.size(); ++i) {
       const bool member = !p.clump.empty() && p.clump[i] >= 0;
       const std::uint64_t id = member ? p.clumps.id[static_cast<std::size_t>(p.clump[i])] : p.id[i];
@@ -233,7 +259,8 @@ class ChuteExperiment final : public Experiment {
             Vec3 d = bodyPosition(p, ref) - m.target;
             if (wall_only) d.y() = 0.0;
             if (wall_only && d.norm() > 3.0 * marker_radius_) continue;
-            if (d.squaredNorm() < best && std::find(taken.begin(), taken.end(), id) == taken.end()) {
+            if (d.squaredNorm() < best &&
+                std::find(taken.begin(), taken.end(), id) == taken.end()) {
               best = d.squaredNorm();
               m.id = id;
             }
@@ -251,12 +278,15 @@ class ChuteExperiment final : public Experiment {
   double channelHeight(double x) const {
     if (!has_top_) return bed_height_;
     // Plane through top_point_ with normal top_normal_: solve for z at (x, y = 0).
-    return top_point_.z() - (top_normal_.x() * (x - top_point_.x()) + top_normal_.y() * (0.0 - top_point_.y())) / top_normal_.z();
+    return top_point_.z() -
+           (top_normal_.x() * (x - top_point_.x()) + top_normal_.y() * (0.0 - top_point_.y())) /
+               top_normal_.z();
   }
 
   void openGate(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
-    switchPhase(world, ctx, [&](sim::Model& m) { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; });
+    switchPhase(world, ctx,
+                [&](sim::Model& m) { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; });
     gate_time_ = last_discharge_ = t;
     // The lab sees the gate open in its film: travel counts from there, as the
     // truth's does (the bed creeps a few mm while the chute tilts; that must not count).
@@ -285,7 +315,8 @@ class ChuteExperiment final : public Experiment {
       const auto it = bodies_.find(m.id);
       if (it == bodies_.end()) continue;
       const double travel = m.start.x() - bodyPosition(p, it->second).x();
-      if (!std::isfinite(m.onset_time) && travel >= kOnset) m.onset_time = crossing(m, travel, kOnset);
+      if (!std::isfinite(m.onset_time) && travel >= kOnset)
+        m.onset_time = crossing(m, travel, kOnset);
       if (travel >= e_.measure_distance) {
         m.travel_time = crossing(m, travel, e_.measure_distance);
         m.velocity = (e_.measure_distance - kOnset) / (m.travel_time - m.onset_time);
@@ -330,7 +361,8 @@ class ChuteExperiment final : public Experiment {
           for (std::uint32_t k = p.clumps.member_begin[c]; k < p.clumps.member_begin[c + 1]; ++k)
             remove[p.clumps.member_ball[k]] = false;
       }
-      switchPhase(world, ctx, [](sim::Model&) {}, remove);
+      switchPhase(
+          world, ctx, [](sim::Model&) {}, remove);
       bodies_ = indexBodies(world->particles());
     }
     return true;
@@ -343,7 +375,7 @@ class ChuteExperiment final : public Experiment {
     return text.str();
   }
 
-  ExperimentSettings e_;
+  ChuteSettings e_;
   double g_;
   Phase phase_ = Phase::Start;
   std::uint64_t every_ = 1, tilt_end_step_ = 0;
@@ -361,10 +393,11 @@ class ChuteExperiment final : public Experiment {
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
   std::unique_ptr<MarkerTracking> tracking_;
-  CameraSettings track_settings_;      // the tracked camera as the renderer has it (takes the calibration photos)
+  CameraSettings
+      track_settings_;  // the tracked camera as the renderer has it (takes the calibration photos)
   nlohmann::json calibration_report_;  // recovered against true camera (null: exact camera used)
   std::string tracking_error_;         // why there is no tracking ("" = none or it ran)
-  double marker_radius_ = 0.0;  // m
+  double marker_radius_ = 0.0;         // m
   bool has_top_ = false;
   Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
 };
@@ -373,7 +406,8 @@ class ChuteExperiment final : public Experiment {
 /// the track that started nearest to it (x-z, within 3 marker radii, each track once) —
 /// the comparison reads both, the tracker never did. Adds tracked_velocity_mps
 /// to `markers`, writes tracks.csv and tracked_vs_truth.png; returns the summary.
-nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const std::filesystem::path& out_dir,
+nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
+                                               const std::filesystem::path& out_dir,
                                                std::ostream& log) const {
   if (!tracking_error_.empty()) {
     log << "tracking: none (" << tracking_error_ << ")\n";
@@ -381,7 +415,8 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
   }
   if (!tracking_ || markers_.empty()) return nullptr;
   const MarkerTracking::Result t = tracking_->finish();
-  track::writeTracksCsv(out_dir / "tracks.csv", t.tracks, tracking_->camera(), tracking_->planePoint(), Vec3::UnitY());
+  track::writeTracksCsv(out_dir / "tracks.csv", t.tracks, tracking_->camera(),
+                        tracking_->planePoint(), Vec3::UnitY());
   std::vector<bool> used(t.tracks.size(), false);
   double sum2 = 0, sum2_rel = 0, max_abs = 0, max_rel = 0;
   int compared = 0, tracked = 0;
@@ -400,8 +435,10 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
       }
     }
     nlohmann::json& out = markers[k];
-    out["track_id"] = best >= 0 ? nlohmann::json(t.tracks[static_cast<std::size_t>(best)].id) : nlohmann::json(nullptr);
-    const double v = best >= 0 ? t.velocities[static_cast<std::size_t>(best)].velocity : std::numeric_limits<double>::quiet_NaN();
+    out["track_id"] = best >= 0 ? nlohmann::json(t.tracks[static_cast<std::size_t>(best)].id)
+                                : nlohmann::json(nullptr);
+    const double v = best >= 0 ? t.velocities[static_cast<std::size_t>(best)].velocity
+                               : std::numeric_limits<double>::quiet_NaN();
     if (best >= 0) used[static_cast<std::size_t>(best)] = true;
     out["tracked_velocity_mps"] = orNull(v);
     if (std::isfinite(v)) ++tracked;
@@ -416,48 +453,58 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers, const st
       points.y.push_back(v);
     }
   }
-  nlohmann::json s = {{"camera", e_.track_camera},
-                      {"frames", t.frames},
-                      {"tracks", t.tracks.size()},
-                      {"markers_tracked", tracked},
-                      {"markers_compared", compared},
-                      {"tracking_s", t.seconds},
-                      {"frames_per_s", t.seconds > 0 ? static_cast<double>(t.frames) / t.seconds : 0.0},
-                      {"method", "HSV red segmentation, redness-weighted centroids, Hungarian linking with constant-velocity "
-                                 "prediction; pixel -> world on the plane of the marker centres; velocity from 2 mm to "
-                                 "measure_distance of travel along the base, as the truth"},
-                      {"calibration", calibration_report_}};
+  nlohmann::json s = {
+      {"camera", e_.track_camera},
+      {"frames", t.frames},
+      {"tracks", t.tracks.size()},
+      {"markers_tracked", tracked},
+      {"markers_compared", compared},
+      {"tracking_s", t.seconds},
+      {"frames_per_s", t.seconds > 0 ? static_cast<double>(t.frames) / t.seconds : 0.0},
+      {"method",
+       "HSV red segmentation, redness-weighted centroids, Hungarian linking with constant-velocity "
+       "prediction; pixel -> world on the plane of the marker centres; velocity from 2 mm to "
+       "measure_distance of travel along the base, as the truth"},
+      {"calibration", calibration_report_}};
   if (!calibration_report_.is_null())
     log << std::defaultfloat << std::setprecision(4) << "tracking camera calibrated from "
         << calibration_report_["photos"].get<int>() << " checkerboard photos: fx "
         << calibration_report_["fx_px"]["recovered"].get<double>() << " px (true "
         << calibration_report_["fx_px"]["true"].get<double>() << "), camera position off by "
-        << 1e3 * calibration_report_["camera_position_error_m"].get<double>() << " mm, view direction by "
-        << calibration_report_["view_direction_error_deg"].get<double>() << " deg, RMS reprojection "
-        << calibration_report_["rms_reprojection_px"].get<double>() << " px\n";
+        << 1e3 * calibration_report_["camera_position_error_m"].get<double>()
+        << " mm, view direction by "
+        << calibration_report_["view_direction_error_deg"].get<double>()
+        << " deg, RMS reprojection " << calibration_report_["rms_reprojection_px"].get<double>()
+        << " px\n";
   if (compared > 0) {
     s["rms_error_mps"] = std::sqrt(sum2 / compared);
     s["max_error_mps"] = max_abs;
     s["rms_error_pct"] = 100.0 * std::sqrt(sum2_rel / compared);
     s["max_error_pct"] = 100.0 * max_rel;
     PlotSpec plot;
-    plot.title = "tracked (images only) against DEM truth, marker velocity over " + measureDistanceText();
+    plot.title =
+        "tracked (images only) against DEM truth, marker velocity over " + measureDistanceText();
     plot.x_label = "truth velocity (m/s)";
     plot.y_label = "tracked velocity (m/s)";
-    double lo = *std::min_element(points.x.begin(), points.x.end()), hi = *std::max_element(points.x.begin(), points.x.end());
-    plot.series = {points, PlotSeries{"tracked = truth", {lo, hi}, {lo, hi}, PlotSeries::Style::Line}};
+    double lo = *std::min_element(points.x.begin(), points.x.end()),
+           hi = *std::max_element(points.x.begin(), points.x.end());
+    plot.series = {points,
+                   PlotSeries{"tracked = truth", {lo, hi}, {lo, hi}, PlotSeries::Style::Line}};
     writePlot(plot, out_dir / "tracked_vs_truth.png");
-    log << std::defaultfloat << std::setprecision(3) << "tracking: " << tracked << " of " << markers_.size()
-        << " markers tracked over " << e_.measure_distance * 1e3 << " mm in " << t.frames
-        << " frames; error against truth: RMS " << s["rms_error_mps"].get<double>() << " m/s ("
-        << s["rms_error_pct"].get<double>() << " %), max " << max_abs << " m/s (" << 100.0 * max_rel << " %)\n";
+    log << std::defaultfloat << std::setprecision(3) << "tracking: " << tracked << " of "
+        << markers_.size() << " markers tracked over " << e_.measure_distance * 1e3 << " mm in "
+        << t.frames << " frames; error against truth: RMS " << s["rms_error_mps"].get<double>()
+        << " m/s (" << s["rms_error_pct"].get<double>() << " %), max " << max_abs << " m/s ("
+        << 100.0 * max_rel << " %)\n";
   } else {
-    log << "tracking: no marker was tracked over the whole " << e_.measure_distance * 1e3 << " mm\n";
+    log << "tracking: no marker was tracked over the whole " << e_.measure_distance * 1e3
+        << " mm\n";
   }
   return s;
 }
 
-void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) {
+void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir,
+                             std::ostream& log) {
   const bool flowed = std::isfinite(gate_time_);
   r["clearance_time_s"] = orNull(clearance_time_);
   r["jammed"] = jammed_;
@@ -495,15 +542,16 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
       }
     }
     const nlohmann::json truth = n ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
-    const nlohmann::json tracked = n_tracked ? nlohmann::json(sum_tracked / n_tracked) : nlohmann::json(nullptr);
+    const nlohmann::json tracked =
+        n_tracked ? nlohmann::json(sum_tracked / n_tracked) : nlohmann::json(nullptr);
     profile.push_back({{"column", c + 1},
                        {"distance_m", e_.marker_columns[c]},
                        {"mean_truth_velocity_mps", truth},
                        {"markers_measured", n},
                        {"mean_tracked_velocity_mps", tracked},
                        {"markers_tracked", n_tracked}});
-    profile_csv << c + 1 << ',' << e_.marker_columns[c] << ',' << (n ? std::to_string(sum / n) : "") << ','
-                << (n_tracked ? std::to_string(sum_tracked / n_tracked) : "") << '\n';
+    profile_csv << c + 1 << ',' << e_.marker_columns[c] << ',' << (n ? std::to_string(sum / n) : "")
+                << ',' << (n_tracked ? std::to_string(sum_tracked / n_tracked) : "") << '\n';
   }
   r["profile"] = profile;
   r["chute"] = {{"inclination_deg", e_.inclination_deg},
@@ -525,25 +573,29 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   // CSV tables with units in the header, and the two plots.
   {
     std::ofstream csv(out_dir / "markers.csv");
-    csv << "id,column,row,start_x_m,start_y_m,start_z_m,onset_time_s,travel_time_s,truth_velocity_mps,"
+    csv << "id,column,row,start_x_m,start_y_m,start_z_m,onset_time_s,travel_time_s,truth_velocity_"
+           "mps,"
            "velocity_from_gate_mps\n";
     for (const Marker& m : markers_)
-      csv << m.id << ',' << m.column << ',' << m.row << ',' << m.start.x() << ',' << m.start.y() << ','
-          << m.start.z() << ',' << m.onset_time << ',' << m.travel_time << ',' << m.velocity << ','
-          << m.velocity_from_gate << '\n';
+      csv << m.id << ',' << m.column << ',' << m.row << ',' << m.start.x() << ',' << m.start.y()
+          << ',' << m.start.z() << ',' << m.onset_time << ',' << m.travel_time << ',' << m.velocity
+          << ',' << m.velocity_from_gate << '\n';
     std::ofstream d(out_dir / "discharge.csv");
     d << "time_after_gate_s,discharged_mass_kg\n";
     for (const auto& [t, m] : discharge_curve_) d << t << ',' << m << '\n';
   }
   if (flowed) {
     PlotSpec prof;
-    prof.title = "marker velocity over the first " + std::to_string(static_cast<int>(std::lround(e_.measure_distance * 1e3))) +
-                 " mm (DEM truth), " + std::to_string(static_cast<int>(std::lround(e_.inclination_deg))) + " deg";
+    prof.title = "marker velocity over the first " +
+                 std::to_string(static_cast<int>(std::lround(e_.measure_distance * 1e3))) +
+                 " mm (DEM truth), " +
+                 std::to_string(static_cast<int>(std::lround(e_.inclination_deg))) + " deg";
     prof.x_label = "velocity along the base (m/s)";
     prof.y_label = "initial height above the base (mm)";
     for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
       PlotSeries s;
-      s.label = "column " + std::to_string(c + 1) + " (" + std::to_string(static_cast<int>(std::lround(e_.marker_columns[c] * 1e3))) + " mm)";
+      s.label = "column " + std::to_string(c + 1) + " (" +
+                std::to_string(static_cast<int>(std::lround(e_.marker_columns[c] * 1e3))) + " mm)";
       std::vector<std::pair<double, double>> points;  // (height mm, velocity), drawn bottom up
       for (const Marker& m : markers_)
         if (m.column == static_cast<int>(c) + 1) points.emplace_back(m.start.z() * 1e3, m.velocity);
@@ -565,9 +617,13 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
     for (const auto& c : r["profile"]) {
       const double x = c["distance_m"].get<double>() * 1e3;
       truth.x.push_back(x);
-      truth.y.push_back(c["mean_truth_velocity_mps"].is_number() ? c["mean_truth_velocity_mps"].get<double>() : NAN);
+      truth.y.push_back(c["mean_truth_velocity_mps"].is_number()
+                            ? c["mean_truth_velocity_mps"].get<double>()
+                            : NAN);
       tracked.x.push_back(x);
-      tracked.y.push_back(c["mean_tracked_velocity_mps"].is_number() ? c["mean_tracked_velocity_mps"].get<double>() : NAN);
+      tracked.y.push_back(c["mean_tracked_velocity_mps"].is_number()
+                              ? c["mean_tracked_velocity_mps"].get<double>()
+                              : NAN);
     }
     columns.series = {truth};
     if (tracking_) columns.series.push_back(tracked);
@@ -586,20 +642,24 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   }
 
   log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit "
-      << (settle_.settled() ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed " << bed_height_ * 1e3
-      << " mm, " << bodies_total_ << " bodies";
+      << (settle_.settled() ? "settled" : "NOT settled") << " at t = " << deposit_time_
+      << " s, bed " << bed_height_ * 1e3 << " mm, " << bodies_total_ << " bodies";
   if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";
   if (!flowed) {
     log << "chute: the gate never opened (the run ended first: raise scene.end_time)\n";
     return;
   }
-  log << "chute: " << (jammed_ ? "JAMMED" : std::isfinite(clearance_time_) ? "cleared" : "still flowing at the end")
-      << ", clearance time " << (std::isfinite(clearance_time_) ? std::to_string(clearance_time_) + " s" : "-")
+  log << "chute: "
+      << (jammed_                          ? "JAMMED"
+          : std::isfinite(clearance_time_) ? "cleared"
+                                           : "still flowing at the end")
+      << ", clearance time "
+      << (std::isfinite(clearance_time_) ? std::to_string(clearance_time_) + " s" : "-")
       << ", discharged " << discharged_count_ << "/" << bodies_total_ << " bodies\n";
   for (const auto& c : profile)
-    log << "  column " << c["column"] << " at " << c["distance_m"].get<double>() * 1e3 << " mm: mean marker velocity "
-        << c["mean_truth_velocity_mps"] << " m/s\n";
+    log << "  column " << c["column"] << " at " << c["distance_m"].get<double>() * 1e3
+        << " mm: mean marker velocity " << c["mean_truth_velocity_mps"] << " m/s\n";
 }
 
 }  // namespace
@@ -608,10 +668,12 @@ std::unique_ptr<Experiment> makeChuteExperiment(const Scene& scene) {
   return std::make_unique<ChuteExperiment>(scene);
 }
 
-
-/// [experiment] keys of type "chute" (experiments.md §c, §d).
-void readChuteSettings(TableReader& t, const SettingsContext& context, ExperimentSettings& e) {
-  readSettleSettings(t, e);
+std::shared_ptr<ExperimentSettings> readChuteSettings(TableReader& t,
+                                                      const SettingsContext& context) {
+  auto settings = std::make_shared<ChuteSettings>();
+  ChuteSettings& e = *settings;
+  readSettleSettings(t, e.settle);
+  e.calibration_photos = readCalibrationPhotos(t, e.calibration_photos);
   const Range positive = Range::positive();
   std::vector<std::string> names;
   for (const auto& w : context.model.walls) names.push_back(w.name);
@@ -620,19 +682,22 @@ void readChuteSettings(TableReader& t, const SettingsContext& context, Experimen
   };
   e.length = t.number("length", e.length, positive);
   e.inclination_deg = t.number("inclination_deg", e.inclination_deg, Range::closed(0, 90));
-  e.deposit_inclination_deg = t.number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
+  e.deposit_inclination_deg =
+      t.number("deposit_inclination_deg", e.deposit_inclination_deg, Range::closed(0, 90));
   e.rotate_gravity = t.string("gravity_tilt", "rotate", {"rotate", "add"}) == "rotate";
   if (!e.rotate_gravity && (e.inclination_deg >= 90 || e.deposit_inclination_deg >= 90))
     t.fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
   e.gate_wall = wallKey("gate_wall", e.gate_wall);
   if (t.has("top_wall")) e.top_wall = wallKey("top_wall", "");
   e.temporary_walls = t.stringList("temporary_walls", names);
-  e.tilt_steps = static_cast<std::uint64_t>(t.integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
+  e.tilt_steps = static_cast<std::uint64_t>(
+      t.integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));
   e.marker_columns = t.numberList("marker_columns", Range::nonNegative());
   e.marker_heights = t.numberList("marker_heights", Range::nonNegative());
   e.marker_height_fractions = t.numberList("marker_height_fractions", Range::closed(0, 1));
   if (!e.marker_heights.empty() && !e.marker_height_fractions.empty())
-    t.fail("marker_height_fractions", "give marker_heights (m) or marker_height_fractions, not both");
+    t.fail("marker_height_fractions",
+           "give marker_heights (m) or marker_height_fractions, not both");
   e.marker_y = t.number("marker_y", e.marker_y, Range::nonNegative());
   e.measure_distance = t.number("measure_distance", e.measure_distance, positive);
   e.remove_beyond = t.number("remove_beyond", e.remove_beyond, positive);
@@ -640,8 +705,10 @@ void readChuteSettings(TableReader& t, const SettingsContext& context, Experimen
   e.track = t.boolean("track", e.track);
   std::vector<std::string> camera_names;
   for (const auto& c : context.cameras) camera_names.push_back(c.name);
-  e.track_camera = t.string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
+  e.track_camera =
+      t.string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
   if (!e.track) e.track_camera.clear();
+  return settings;
 }
 
 }  // namespace rocklab::experiments

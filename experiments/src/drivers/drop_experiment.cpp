@@ -5,11 +5,11 @@
 // the measured e is lower than the contact law's by about g t_c / v (5e-4 for a
 // 2 m/s impact and a 0.1 ms contact); the analytic curve of Eq 4-4 is reported
 // beside it.
+#include "drivers/drop_experiment.h"
+
 #include <cmath>
 #include <ostream>
 
-#include "drivers/experiment.h"
-#include "drivers/registry.h"
 #include "rocklab/sim/timestep.h"
 
 namespace rocklab::experiments {
@@ -23,7 +23,8 @@ class DropExperiment final : public Experiment {
   bool wantsSnapshot(std::uint64_t) const override { return !done_; }
 
   void observe(const sim::Snapshot& s) override {
-    const geometry::Vec3 up = gravity_.norm() > 0 ? geometry::Vec3(-gravity_.normalized()) : geometry::Vec3::UnitZ();
+    const geometry::Vec3 up =
+        gravity_.norm() > 0 ? geometry::Vec3(-gravity_.normalized()) : geometry::Vec3::UnitZ();
     const geometry::Vec3 v = s.clump_velocity.empty() ? s.velocity[0] : s.clump_velocity[0];
     const double vn = v.dot(up);
     const bool touching = s.wall_contacts + s.contacts > 0;
@@ -57,11 +58,13 @@ class DropExperiment final : public Experiment {
       d["impact_speed_mps"] = -v_before_;
       d["rebound_speed_mps"] = v_after_;
       d["contact_time_s"] = t_after_ - t_touch_;
-      d["method"] = "e = v_after / v_before (Eq 4-3), normal velocity of the last step before and the first after the contact";
+      d["method"] =
+          "e = v_after / v_before (Eq 4-3), normal velocity of the last step before and the first "
+          "after the contact";
       r["restitution"] = e;
       log << "drop: restitution " << e << " (Eq 4-4 for beta = " << beta_ << ": "
-          << d["analytic_restitution"].get<double>() << "), impact " << -v_before_ << " m/s, contact "
-          << (t_after_ - t_touch_) << " s\n";
+          << d["analytic_restitution"].get<double>() << "), impact " << -v_before_
+          << " m/s, contact " << (t_after_ - t_touch_) << " s\n";
     } else {
       d["restitution"] = nullptr;
       r["restitution"] = nullptr;
@@ -79,10 +82,13 @@ class DropExperiment final : public Experiment {
 
 }  // namespace
 
-std::unique_ptr<Experiment> makeDropExperiment(const Scene& scene) { return std::make_unique<DropExperiment>(scene); }
+std::unique_ptr<Experiment> makeDropExperiment(const Scene& scene) {
+  return std::make_unique<DropExperiment>(scene);
+}
 
-
-/// The drop test has no keys of its own (experiments.md §a).
-void readDropSettings(TableReader& /*table*/, const SettingsContext& /*context*/, ExperimentSettings& /*settings*/) {}
+std::shared_ptr<ExperimentSettings> readDropSettings(TableReader& /*table*/,
+                                                     const SettingsContext& /*context*/) {
+  return std::make_shared<DropSettings>();
+}
 
 }  // namespace rocklab::experiments

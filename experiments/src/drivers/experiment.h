@@ -43,7 +43,8 @@ class Experiment {
   /// A few words for the progress line, e.g. "phase flow, 812 bodies left".
   virtual std::string progress() const { return {}; }
   /// Adds the figures to results.json and writes the experiment's CSV and PNG files.
-  virtual void report(nlohmann::json& results, const std::filesystem::path& out_dir, std::ostream& log) = 0;
+  virtual void report(nlohmann::json& results, const std::filesystem::path& out_dir,
+                      std::ostream& log) = 0;
 };
 
 /// The driver for scene.experiment_type, or null for a plain run (drivers/registry.cpp).
@@ -73,6 +74,7 @@ std::size_t wallIndex(const sim::Model& model, const std::string& name);
 /// Rebuilds `world` from its state after `edit` changed a copy of the model and
 /// `remove` (one flag per ball, may be empty) deleted bodies.
 void switchPhase(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx,
-                 const std::function<void(sim::Model&)>& edit, const std::vector<bool>& remove = {});
+                 const std::function<void(sim::Model&)>& edit,
+                 const std::vector<bool>& remove = {});
 
 }  // namespace rocklab::experiments

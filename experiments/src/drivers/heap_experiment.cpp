@@ -1,17 +1,17 @@
 // Heap test (experiments.md §b): the poured pebbles come to rest on the table;
 // the angle of repose is measured from the final positions (heap_analysis.h).
+#include "drivers/heap_experiment.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <ostream>
 
-#include "camera/camera_calibration.h"
-#include "camera/camera_recorder.h"
-#include "drivers/experiment.h"
-#include "drivers/registry.h"
-#include "drivers/settle.h"
 #include "analysis/heap_analysis.h"
 #include "analysis/plot.h"
+#include "camera/camera_calibration.h"
+#include "camera/camera_recorder.h"
+#include "drivers/settle.h"
 #include "rocklab/render/image_io.h"
 #include "rocklab/track/plane.h"
 
@@ -21,16 +21,20 @@ namespace {
 
 class HeapExperiment final : public Experiment {
  public:
-  explicit HeapExperiment(const Scene& scene) : e_(*scene.experiment), settle_(*scene.experiment) {
+  explicit HeapExperiment(const Scene& scene)
+      : e_(settingsOf<HeapSettings>(scene)), settle_(e_.settle) {
     if (!scene.cameras.empty()) camera_ = scene.cameras.front();
   }
 
   // The photograph: the camera's last raw frame before the heap is measured.
-  std::string trackingCamera() const override { return balls_.empty() ? camera_.name : std::string(); }
+  std::string trackingCamera() const override {
+    return balls_.empty() ? camera_.name : std::string();
+  }
   void cameraFrame(std::uint64_t, double, const cv::Mat& raw) override { photo_ = raw.clone(); }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext&) override {
-    const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
+    const auto every =
+        static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
     if (world->stepCount() % every != 0) return true;
     const double t = world->time();
     if (!settle_.over(*world)) return true;
@@ -43,7 +47,7 @@ class HeapExperiment final : public Experiment {
 
   std::string progress() const override {
     return "max speed " + std::to_string(settle_.maxSpeed()).substr(0, 6) + " m/s (settled below " +
-           std::to_string(e_.settle_speed).substr(0, 6) + ")";
+           std::to_string(e_.settle.speed).substr(0, 6) + ")";
   }
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override {
@@ -69,7 +73,8 @@ class HeapExperiment final : public Experiment {
       h["method"] = a.method;
       log << "heap: angle of repose " << a.mean_deg << " deg (flanks";
       for (double f : a.flank_deg) log << " " << f;
-      log << "), height " << a.height_m << " m" << (settle_.settled() ? "" : " — NOT settled (settle_max_time reached)") << "\n";
+      log << "), height " << a.height_m << " m"
+          << (settle_.settled() ? "" : " — NOT settled (settle_max_time reached)") << "\n";
     } catch (const std::exception& ex) {
       r["angle_of_repose_deg"] = nullptr;
       h["note"] = std::string("no heap to measure: ") + ex.what();
@@ -121,13 +126,17 @@ class HeapExperiment final : public Experiment {
     geometry::Camera camera = camera_.camera;
     if (e_.calibration_photos > 0) {
       try {
-        const WallCalibration cal = calibrateOnWall(camera_.camera, renderOptionsFor(camera_), axis_point,
-                                                    towards_camera, e_.calibration_photos);
+        const WallCalibration cal =
+            calibrateOnWall(camera_.camera, renderOptionsFor(camera_), axis_point, towards_camera,
+                            e_.calibration_photos);
         camera = cal.camera;
         calibration = cal.report;
-      } catch (const std::exception& e) {  // no calibrated camera: no photograph angle, the rest stands
-        log << "heap: no angle from the photograph (camera calibration failed: " << e.what() << ")\n";
-        return {{"file", "heap_side.png"}, {"error", std::string("camera calibration failed: ") + e.what()}};
+      } catch (
+          const std::exception& e) {  // no calibrated camera: no photograph angle, the rest stands
+        log << "heap: no angle from the photograph (camera calibration failed: " << e.what()
+            << ")\n";
+        return {{"file", "heap_side.png"},
+                {"error", std::string("camera calibration failed: ") + e.what()}};
       }
     }
     std::vector<double> xs, zs;
@@ -137,8 +146,10 @@ class HeapExperiment final : public Experiment {
           const cv::Vec3b p = photo_.at<cv::Vec3b>(row, u);
           return std::max({p[0], p[1], p[2]}) > 70;
         };
-        if (!(bright(v) && bright(v - 1) && bright(v - 2))) continue;  // three in a row: not a speck
-        if (const auto w = track::pixelToPlane(camera, cv::Point2d(u, v - 2), axis_point, towards_camera)) {
+        if (!(bright(v) && bright(v - 1) && bright(v - 2)))
+          continue;  // three in a row: not a speck
+        if (const auto w =
+                track::pixelToPlane(camera, cv::Point2d(u, v - 2), axis_point, towards_camera)) {
           if (w->z() > e_.base_z + 0.005) {
             xs.push_back(w->x() - cx);
             zs.push_back(w->z() - e_.base_z);
@@ -151,14 +162,16 @@ class HeapExperiment final : public Experiment {
       out["note"] = "no pile found in the photograph";
       return out;
     }
-    const std::size_t peak = static_cast<std::size_t>(std::max_element(zs.begin(), zs.end()) - zs.begin());
+    const std::size_t peak =
+        static_cast<std::size_t>(std::max_element(zs.begin(), zs.end()) - zs.begin());
     const double height = zs[peak];
     std::vector<double> angles;
     for (int side : {-1, 1}) {
       double sx = 0, sz = 0, sxx = 0, sxz = 0;
       int n = 0;
       for (std::size_t k = 0; k < xs.size(); ++k) {
-        if ((xs[k] - xs[peak]) * side <= 0 || zs[k] < 0.2 * height || zs[k] > 0.8 * height) continue;
+        if ((xs[k] - xs[peak]) * side <= 0 || zs[k] < 0.2 * height || zs[k] > 0.8 * height)
+          continue;
         sx += xs[k];
         sz += zs[k];
         sxx += xs[k] * xs[k];
@@ -166,7 +179,8 @@ class HeapExperiment final : public Experiment {
         ++n;
       }
       const double den = n * sxx - sx * sx;
-      angles.push_back(n >= 3 && den > 0 ? std::atan(std::abs((n * sxz - sx * sz) / den)) * 180.0 / std::numbers::pi
+      angles.push_back(n >= 3 && den > 0 ? std::atan(std::abs((n * sxz - sx * sz) / den)) * 180.0 /
+                                               std::numbers::pi
                                          : std::numeric_limits<double>::quiet_NaN());
     }
     const double mean = 0.5 * (angles[0] + angles[1]);
@@ -175,15 +189,18 @@ class HeapExperiment final : public Experiment {
            {"angle_deg", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
            {"height_m", height},
            {"calibration", calibration},
-           {"method", "side photograph: top of the pile per pixel column, mapped onto the vertical plane through "
-                      "the heap axis, least-squares line per flank between 20 % and 80 % of the height"}};
+           {"method",
+            "side photograph: top of the pile per pixel column, mapped onto the vertical plane "
+            "through "
+            "the heap axis, least-squares line per flank between 20 % and 80 % of the height"}};
     if (std::isfinite(mean) && geometric.is_number())
       out["difference_to_geometric_deg"] = mean - geometric.get<double>();
-    log << "heap: from the side photograph " << mean << " deg (flanks " << angles[0] << ", " << angles[1] << ")\n";
+    log << "heap: from the side photograph " << mean << " deg (flanks " << angles[0] << ", "
+        << angles[1] << ")\n";
     return out;
   }
 
-  ExperimentSettings e_;
+  HeapSettings e_;
   CameraSettings camera_;  // the first camera: it takes the photograph
   cv::Mat photo_;
   SettleDetector settle_;
@@ -193,14 +210,18 @@ class HeapExperiment final : public Experiment {
 
 }  // namespace
 
-std::unique_ptr<Experiment> makeHeapExperiment(const Scene& scene) { return std::make_unique<HeapExperiment>(scene); }
+std::unique_ptr<Experiment> makeHeapExperiment(const Scene& scene) {
+  return std::make_unique<HeapExperiment>(scene);
+}
 
-
-/// [experiment] keys of type "heap" (experiments.md §b).
-void readHeapSettings(TableReader& t, const SettingsContext& /*context*/, ExperimentSettings& e) {
-  readSettleSettings(t, e);
-  e.base_z = t.number("base_z", e.base_z);
-  e.bin_width = t.number("bin_width", e.bin_width, Range::positive());
+std::shared_ptr<ExperimentSettings> readHeapSettings(TableReader& t,
+                                                     const SettingsContext& /*context*/) {
+  auto e = std::make_shared<HeapSettings>();
+  readSettleSettings(t, e->settle);
+  e->calibration_photos = readCalibrationPhotos(t, e->calibration_photos);
+  e->base_z = t.number("base_z", e->base_z);
+  e->bin_width = t.number("bin_width", e->bin_width, Range::positive());
+  return e;
 }
 
 }  // namespace rocklab::experiments

@@ -1,5 +1,9 @@
 #include "drivers/registry.h"
 
+#include "drivers/chute_experiment.h"
+#include "drivers/drop_experiment.h"
+#include "drivers/heap_experiment.h"
+
 namespace rocklab::experiments {
 
 const std::vector<ExperimentDriver>& experimentDrivers() {
@@ -20,16 +24,6 @@ const ExperimentDriver* findExperimentDriver(const std::string& type) {
 std::unique_ptr<Experiment> makeExperiment(const Scene& scene) {
   const ExperimentDriver* driver = findExperimentDriver(scene.experiment_type);
   return driver ? driver->make(scene) : nullptr;
-}
-
-void readSettleSettings(TableReader& t, ExperimentSettings& e) {
-  const Range positive = Range::positive();
-  e.settle_speed = t.number("settle_speed", e.settle_speed, positive);
-  e.settle_min_time = t.number("settle_min_time", e.settle_min_time, Range::nonNegative());
-  e.settle_max_time = t.number("settle_max_time", e.settle_max_time, positive);
-  e.calibration_photos = static_cast<int>(t.integer("calibration_photos", e.calibration_photos, Range::closed(0, 11)));
-  if (e.calibration_photos > 0 && e.calibration_photos < 3)
-    t.fail("calibration_photos", "needs 0 (exact camera) or 3 to 11 photos (got " + std::to_string(e.calibration_photos) + ")");
 }
 
 }  // namespace rocklab::experiments

@@ -5,13 +5,14 @@
 // not before settle_min_time; at settle_max_time it ends unsettled, and the
 // report says so instead of hiding it.
 #include "drivers/experiment.h"
+#include "drivers/experiment_settings.h"
 
 namespace rocklab::experiments {
 
 class SettleDetector {
  public:
-  explicit SettleDetector(const ExperimentSettings& e)
-      : speed_limit_(e.settle_speed), min_time_(e.settle_min_time), max_time_(e.settle_max_time) {}
+  explicit SettleDetector(const SettleSettings& s)
+      : speed_limit_(s.speed), min_time_(s.min_time), max_time_(s.max_time) {}
 
   /// Call on a sample step: true once the deposit is over (settled, or out of time).
   bool over(const sim::World& world) {

@@ -53,6 +53,21 @@ H5::DataSet createEnergyTable(const H5::Group& group) {
   return table;
 }
 
+/// Whether a frame holds a Snapshot array (its FrameWrite rule in ROCKLAB_SNAPSHOT_FIELDS).
+bool framed(FrameWrite rule, bool empty, bool no_clumps) {
+  switch (rule) {
+    case FrameWrite::Always:
+      return true;
+    case FrameWrite::IfAny:
+      return !empty;
+    case FrameWrite::WithClumps:
+      return !no_clumps;
+    case FrameWrite::Never:
+      return false;
+  }
+  return false;
+}
+
 std::string frameGroupName(std::size_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "frames/%06zu", frame);
@@ -126,22 +141,11 @@ void RunFile::writeFrame(const Snapshot& snapshot) {
     const H5::Group frame = impl_->file.createGroup(frameGroupName(impl_->frames));
     writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
     writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
-    writeArray(frame, "position", snapshot.position, "m");
-    writeArray(frame, "velocity", snapshot.velocity, "m/s");
-    writeArray(frame, "omega", snapshot.omega, "rad/s");
-    writeArray(frame, "force", snapshot.force, "N");
-    writeArray(frame, "radius", snapshot.radius, "m");
-    writeArray(frame, "id", snapshot.id, "");
-    if (!snapshot.material.empty()) writeArray(frame, "material", snapshot.material, "");
-    if (!snapshot.wall_active.empty()) writeArray(frame, "wall_active", snapshot.wall_active, "");
-    if (!snapshot.clump_id.empty()) {
-      writeArray(frame, "clump", snapshot.clump, "");
-      writeArray(frame, "clump_position", snapshot.clump_position, "m");
-      writeArray(frame, "clump_velocity", snapshot.clump_velocity, "m/s");
-      writeArray(frame, "clump_omega", snapshot.clump_omega, "rad/s");
-      writeArray(frame, "clump_orientation", snapshot.clump_orientation, "");
-      writeArray(frame, "clump_id", snapshot.clump_id, "");
-    }
+#define ROCKLAB_WRITE(type, name, index, unit, frame_write, meaning)                     \
+  if (framed(FrameWrite::frame_write, snapshot.name.empty(), snapshot.clump_id.empty())) \
+    writeArray(frame, #name, snapshot.name, unit);
+    ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_WRITE)
+#undef ROCKLAB_WRITE
     // Flushing makes the frame (and the energy rows before it) survive a kill.
     impl_->file.flush(H5F_SCOPE_GLOBAL);
   });
@@ -206,13 +210,10 @@ struct RunFileReader::Impl {
   H5::H5File file;
   std::string scene;
   std::vector<std::string> frame_names;
-  // Storage of the current frame.
-  std::vector<Vec3> position, velocity, omega, force, clump_position, clump_velocity, clump_omega, clump_force;
-  std::vector<double> radius;
-  std::vector<std::uint64_t> id, clump_id;
-  std::vector<std::int32_t> material, clump;
-  std::vector<std::uint8_t> wall_active;
-  std::vector<Quat> clump_orientation;
+  // Storage of the current frame (arrays a frame never holds stay empty).
+#define ROCKLAB_STORAGE(type, name, index, unit, frame, meaning) std::vector<type> name;
+  ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_STORAGE)
+#undef ROCKLAB_STORAGE
   Snapshot snapshot;
 };
 
@@ -250,35 +251,14 @@ const Snapshot& RunFileReader::frame(std::size_t k) {
     s = Snapshot{};
     g.openAttribute("time").read(H5::PredType::NATIVE_DOUBLE, &s.time);
     g.openAttribute("step").read(H5::PredType::NATIVE_UINT64, &s.step);
-    m.position = readArray<Vec3>(g, "position");
-    m.velocity = readArray<Vec3>(g, "velocity");
-    m.omega = readArray<Vec3>(g, "omega");
-    m.force = readArray<Vec3>(g, "force");
-    m.radius = readArray<double>(g, "radius");
-    m.id = readArray<std::uint64_t>(g, "id");
-    m.material = readArray<std::int32_t>(g, "material");
-    m.wall_active = readArray<std::uint8_t>(g, "wall_active");
-    m.clump = readArray<std::int32_t>(g, "clump");
-    m.clump_position = readArray<Vec3>(g, "clump_position");
-    m.clump_velocity = readArray<Vec3>(g, "clump_velocity");
-    m.clump_omega = readArray<Vec3>(g, "clump_omega");
-    m.clump_orientation = readArray<Quat>(g, "clump_orientation");
-    m.clump_id = readArray<std::uint64_t>(g, "clump_id");
+#define ROCKLAB_READ(type, name, index, unit, frame, meaning) \
+  if (FrameWrite::frame != FrameWrite::Never) m.name = readArray<type>(g, #name);
+    ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_READ)
+#undef ROCKLAB_READ
     if (m.material.empty()) m.material.assign(m.position.size(), 0);  // files from before materials were stored
-    s.position = m.position;
-    s.velocity = m.velocity;
-    s.omega = m.omega;
-    s.force = m.force;
-    s.radius = m.radius;
-    s.id = m.id;
-    s.material = m.material;
-    s.wall_active = m.wall_active;
-    s.clump = m.clump;
-    s.clump_position = m.clump_position;
-    s.clump_velocity = m.clump_velocity;
-    s.clump_omega = m.clump_omega;
-    s.clump_orientation = m.clump_orientation;
-    s.clump_id = m.clump_id;
+#define ROCKLAB_VIEW(type, name, index, unit, frame, meaning) s.name = m.name;
+    ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_VIEW)
+#undef ROCKLAB_VIEW
     detail::particleCount(s);
     return s;
   } catch (const H5::Exception& e) {

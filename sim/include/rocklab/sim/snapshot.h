@@ -23,28 +23,47 @@ struct Energy {
   }
 };
 
+/// What a Snapshot array is indexed by: balls [n] (clump members included),
+/// clumps [c] or walls.
+enum class SnapshotIndex { Ball, Clump, Wall };
+/// Whether a run.h5 frame (output/run_file.cpp) writes a Snapshot array: Always,
+/// IfAny (when not empty), WithClumps (when the snapshot has clumps) or Never.
+enum class FrameWrite { Always, IfAny, WithClumps, Never };
+
+// The Snapshot's arrays, listed once: the struct, the run.h5 frame writer and
+// reader, and the size check (output/snapshot_check.h) expand this table.
+// X(type, name, index, unit, frame, meaning); index is a SnapshotIndex, frame a
+// FrameWrite. Clump arrays are all empty without clumps; member balls appear in
+// the ball arrays too. Where each gets its value: World::Impl::snapshot
+// (sim/src/stages/observe.cpp).
+#define ROCKLAB_SNAPSHOT_FIELDS(X)                                                      \
+  X(geometry::Vec3, position, Ball, "m", Always, "at `time`")                           \
+  X(geometry::Vec3, velocity, Ball, "m/s", Always, "synchronised to `time`")            \
+  X(geometry::Vec3, omega, Ball, "rad/s", Always, "synchronised to `time`")             \
+  X(geometry::Vec3, force, Ball, "N", Always, "total including gravity")                \
+  X(double, radius, Ball, "m", Always, "")                                              \
+  X(std::uint64_t, id, Ball, "", Always, "stable id")                                   \
+  X(std::int32_t, material, Ball, "", IfAny, "index into Model::materials")             \
+  X(std::uint8_t, wall_active, Wall, "", IfAny, "1 when the wall exists at `time`")     \
+  X(std::int32_t, clump, Ball, "", WithClumps, "owning clump or -1")                    \
+  X(geometry::Vec3, clump_position, Clump, "m", WithClumps, "centre of mass")           \
+  X(geometry::Vec3, clump_velocity, Clump, "m/s", WithClumps, "synchronised to `time`") \
+  X(geometry::Vec3, clump_omega, Clump, "rad/s", WithClumps, "synchronised to `time`")  \
+  X(geometry::Quat, clump_orientation, Clump, "", WithClumps, "body -> world")          \
+  X(geometry::Vec3, clump_force, Clump, "N", Never, "total including gravity")          \
+  X(std::uint64_t, clump_id, Clump, "", WithClumps, "stable id")
+
+#define ROCKLAB_SNAPSHOT_SPAN(type, name, index, unit, frame, meaning) std::span<const type> name;
+
 struct Snapshot {
   double time = 0.0;         // s
   std::uint64_t step = 0;    // steps since t = 0
-  std::span<const geometry::Vec3> position;  // [n] m
-  std::span<const geometry::Vec3> velocity;  // [n] m/s, synchronised to `time`
-  std::span<const geometry::Vec3> omega;     // [n] rad/s, synchronised to `time`
-  std::span<const geometry::Vec3> force;     // [n] N, total including gravity
-  std::span<const double> radius;            // [n] m
-  std::span<const std::uint64_t> id;         // [n]
-  std::span<const std::int32_t> material;    // [n] index into Model::materials
-  std::span<const std::uint8_t> wall_active; // [walls] 1 when the wall exists at `time`
-  // Rigid clumps (all empty without clumps). Member balls appear above too.
-  std::span<const std::int32_t> clump;                 // [n] owning clump or -1
-  std::span<const geometry::Vec3> clump_position;      // [c] m, centre of mass
-  std::span<const geometry::Vec3> clump_velocity;      // [c] m/s, synchronised to `time`
-  std::span<const geometry::Vec3> clump_omega;         // [c] rad/s, synchronised to `time`
-  std::span<const geometry::Quat> clump_orientation;   // [c] body -> world
-  std::span<const geometry::Vec3> clump_force;         // [c] N, total including gravity
-  std::span<const std::uint64_t> clump_id;             // [c]
+  ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_SNAPSHOT_SPAN)
   Energy energy;
   std::size_t contacts = 0;       // touching ball–ball pairs
   std::size_t wall_contacts = 0;  // touching ball–wall pairs
 };
+
+#undef ROCKLAB_SNAPSHOT_SPAN
 
 }  // namespace rocklab::sim

@@ -1,0 +1,232 @@
+// Stepping of a run (run_internal.h): the experiment advanced before every
+// step, the observer only on steps something looks at (frames, energy rows,
+// the experiment, cameras), checkpoints, progress on stderr.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <unordered_set>
+
+#include "rocklab/sim/output/checkpoint.h"
+#include "run/run_internal.h"
+
+namespace rocklab::experiments::detail {
+
+namespace {
+
+std::string clockText(double s) {
+  std::ostringstream o;
+  const auto total = static_cast<long>(std::lround(s));
+  o << total / 3600 << ':' << std::setw(2) << std::setfill('0') << (total / 60) % 60 << ':'
+    << std::setw(2) << total % 60;
+  return o.str();
+}
+
+/// Progress on stderr: a line every 2 s on a terminal (overwritten), every 15 s otherwise.
+class Progress {
+ public:
+  Progress(bool enabled, std::uint64_t total_steps, double dt)
+      : enabled_(enabled),
+        tty_(isatty(STDERR_FILENO)),
+        total_(total_steps),
+        dt_(dt),
+        start_(Clock::now()),
+        last_(start_) {}
+  void update(std::uint64_t done, const std::string& extra) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (seconds(last_, now) < (tty_ ? 2.0 : 15.0)) return;
+    last_ = now;
+    const double elapsed = seconds(start_, now);
+    const double rate = done / std::max(elapsed, 1e-9);
+    const double eta = (total_ - done) / std::max(rate, 1e-9);
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(4) << "t = " << done * dt_ << " / " << total_ * dt_
+      << " s  " << std::setprecision(1) << 100.0 * done / total_ << "%  " << std::setprecision(0)
+      << rate << " steps/s  ETA " << clockText(eta) << "  " << extra;
+    std::cerr << (tty_ ? "\r" : "") << s.str() << (tty_ ? "\033[K" : "\n") << std::flush;
+    printed_ = true;
+  }
+  void finish() {
+    if (enabled_ && tty_ && printed_) std::cerr << "\n";
+  }
+
+ private:
+  bool enabled_, tty_;
+  std::uint64_t total_;
+  double dt_;
+  Clock::time_point start_, last_;
+  bool printed_ = false;
+};
+
+/// Network checks and seconds per engine stage, summed over the Worlds an
+/// experiment builds: a World's counters start at 0, and switchPhase makes the
+/// new World before the old one goes, so a new address is a new World.
+class WorldStatsSum {
+ public:
+  void after(const sim::World& world, RunRecord& record) {
+    if (&world != seen_) {  // a new World (phase)
+      checks_before_ += checks_seen_;
+      for (std::size_t s = 0; s < sim::kStageCount; ++s) stages_before_[s] += stages_seen_[s];
+      seen_ = &world;
+    }
+    checks_seen_ = world.stats().network_checks;
+    stages_seen_ = world.stats().stage_seconds;
+    record.network_ratio = std::max(record.network_ratio, world.stats().network_step_ratio);
+    record.network_checks = checks_before_ + checks_seen_;
+    for (std::size_t s = 0; s < sim::kStageCount; ++s)
+      record.stage_seconds[s] = stages_before_[s] + stages_seen_[s];
+  }
+
+ private:
+  std::uint64_t checks_before_ = 0, checks_seen_ = 0;
+  std::array<double, sim::kStageCount> stages_before_{}, stages_seen_{};
+  const sim::World* seen_ = nullptr;
+};
+
+class RunLoop {
+ public:
+  RunLoop(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup)
+      : scene_(scene),
+        options_(options),
+        setup_(setup),
+        world_(setup.world),
+        context_{options.threads, &log},
+        progress_(options.progress, setup.total_steps, setup.dt) {}
+
+  RunRecord run() {
+    record_.first_step = world_->stepCount();
+    end_step_ = std::max(setup_.total_steps, record_.first_step);
+    record_.loop_start = Clock::now();
+    try {
+      while (world_->stepCount() < end_step_ && stepOnce()) {
+      }
+    } catch (const sim::WatchdogError& e) {
+      stopWith("stopped_by_watchdog", e.what(), kExitWatchdog);
+    } catch (const std::invalid_argument& e) {
+      // A phase switch of the experiment made an unusable world (e.g. a wall
+      // setting that only fails once the wall is placed): stop, keep the outputs.
+      stopWith("failed", std::string("experiment phase switch: ") + e.what(), kExitBadInput);
+    } catch (const std::exception& e) {
+      // Anything else the experiment or an output met (a photograph it cannot read, a
+      // full disk): stop with the reason instead of aborting; outputs so far are kept.
+      stopWith("failed", e.what(), kExitFailed);
+    }
+    record_.loop_end = Clock::now();
+    progress_.finish();
+    finishOutputs();
+    return record_;
+  }
+
+ private:
+  /// One step with what comes before and after it; false = the run stops here.
+  bool stepOnce() {
+    if (stopRequested()) {
+      stopWith("interrupted", "", kExitInterrupted);
+      return false;
+    }
+    Experiment* experiment = setup_.experiment.get();
+    if (experiment && !record_.experiment_over)
+      record_.experiment_over = !experiment->advance(world_, context_);
+    chooseObservations();
+    record_.ball_steps += world_->particles().size();
+    if (frame_due_ || experiment_due_ || energy_due_ || camera_due_)
+      world_->step([this](const sim::Snapshot& s) { observe(s); });
+    else
+      world_->step();
+    stats_.after(*world_, record_);
+    const std::uint64_t done = world_->stepCount();
+    if (setup_.checkpoint_every && done % setup_.checkpoint_every == 0) writeCheckpoint();
+    progress_.update(done, experiment ? experiment->progress() : "");
+    return !record_.experiment_over;
+  }
+
+  /// What the coming step shows to whom. Frames at t = 0, every frame interval
+  /// and at the last step (or the step the experiment ended); energy rows at
+  /// frames and every energy interval.
+  void chooseObservations() {
+    const std::uint64_t k = world_->stepCount();
+    const Experiment* experiment = setup_.experiment.get();
+    frame_due_ = k == record_.first_step || k + 1 >= end_step_ || record_.experiment_over ||
+                 (setup_.frame_every && k % setup_.frame_every == 0);
+    experiment_due_ = experiment && !record_.experiment_over && experiment->wantsSnapshot(k);
+    energy_due_ = setup_.energy_every && k % setup_.energy_every == 0;
+    camera_due_ = std::any_of(setup_.cameras.begin(), setup_.cameras.end(),
+                              [&](const auto& c) { return c->due(world_->time()); });
+  }
+
+  void observe(const sim::Snapshot& s) {
+    if (experiment_due_) setup_.experiment->observe(s);
+    if (camera_due_) {
+      const auto markers = setup_.experiment ? setup_.experiment->markerBodies()
+                                             : std::unordered_set<std::uint64_t>{};
+      for (auto& c : setup_.cameras)
+        if (c->due(s.time)) c->record(s, world_->model(), markers);
+    }
+    if (frame_due_ || energy_due_) writeObservation(s);
+  }
+
+  /// The energy row, the frame when one is due, and the last observed figures.
+  void writeObservation(const sim::Snapshot& s) {
+    const auto t0 = Clock::now();
+    sim::Snapshot& last = record_.last;
+    last.time = s.time;
+    last.step = s.step;
+    last.energy = s.energy;
+    last.contacts = s.contacts;
+    last.wall_contacts = s.wall_contacts;
+    if (setup_.run_file) {
+      setup_.run_file->appendEnergy(s);
+      if (frame_due_) setup_.run_file->writeFrame(s);
+    }
+    if (setup_.vtk && frame_due_) setup_.vtk->writeFrame(s);
+    if (frame_due_) ++record_.frames;
+    record_.output_seconds += seconds(t0, Clock::now());
+  }
+
+  void writeCheckpoint() {
+    if (!scene_.run.checkpoint) return;
+    const auto t0 = Clock::now();
+    sim::output::writeCheckpoint(options_.out_dir / "checkpoint.h5", world_->exportState(),
+                                 scene_.text);
+    record_.output_seconds += seconds(t0, Clock::now());
+  }
+
+  /// The last checkpoint (a blown-up state is no place to restart from) and run.h5 closed.
+  void finishOutputs() {
+    if (record_.exit_code != kExitWatchdog) writeCheckpoint();
+    const auto t0 = Clock::now();
+    if (setup_.run_file) setup_.run_file->close(record_.exit_code != kExitOk);
+    record_.vtk_frames = setup_.vtk ? setup_.vtk->frameCount() : 0;
+    record_.output_seconds += seconds(t0, Clock::now());
+  }
+
+  void stopWith(const std::string& status, const std::string& message, int exit_code) {
+    record_.status = status;
+    record_.message = message;
+    record_.exit_code = exit_code;
+  }
+
+  const Scene& scene_;
+  const RunOptions& options_;
+  RunSetup& setup_;
+  std::unique_ptr<sim::World>& world_;  // the experiment may replace it
+  const ExperimentContext context_;
+  Progress progress_;
+  WorldStatsSum stats_;
+  RunRecord record_;
+  std::uint64_t end_step_ = 0;
+  bool frame_due_ = false, experiment_due_ = false, energy_due_ = false, camera_due_ = false;
+};
+
+}  // namespace
+
+RunRecord stepRun(const Scene& scene, const RunOptions& options, std::ostream& log,
+                  RunSetup& setup) {
+  return RunLoop(scene, options, log, setup).run();
+}
+
+}  // namespace rocklab::experiments::detail

@@ -1,0 +1,159 @@
+// Set-up of a run (run_internal.h): everything that can fail on bad input
+// happens here, before anything is written to the output directory.
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+#include "rocklab/sim/output/checkpoint.h"
+#include "run/run_internal.h"
+
+namespace rocklab::experiments::detail {
+
+namespace {
+
+namespace out = sim::output;
+
+/// The World at t = 0 from the scene, or where options.restart left it.
+int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
+              std::unique_ptr<sim::World>& world) {
+  try {
+    if (!options.restart.empty()) {
+      out::Checkpoint cp = out::readCheckpoint(options.restart);
+      world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
+    } else {
+      world =
+          std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, options.threads);
+    }
+  } catch (const out::CheckpointError& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string())
+        << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+/// Step counts of the scene's end and of its output intervals at the World's dt.
+void countSteps(const Scene& scene, double dt, RunSetup& setup) {
+  setup.dt = dt;
+  setup.total_steps = scene.run.steps > 0
+                          ? scene.run.steps
+                          : static_cast<std::uint64_t>(std::llround(scene.run.end_time / dt));
+  auto stepsFor = [dt](double interval) -> std::uint64_t {
+    return interval > 0
+               ? std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(interval / dt)))
+               : 0;
+  };
+  setup.frame_every = stepsFor(scene.run.frame_interval);
+  setup.energy_every = stepsFor(scene.run.energy_interval);
+  setup.checkpoint_every = stepsFor(scene.run.checkpoint_interval);
+}
+
+/// Active modules: what this scene constructs (and so pays for), for the log and results.json.
+std::vector<std::string> activeModules(const Scene& scene, const sim::World& world,
+                                       bool has_experiment) {
+  const sim::Model& model = world.model();
+  std::vector<std::string> modules;
+  modules.push_back(model.contact.law == sim::ContactLaw::Linear ? "contact:linear"
+                                                                 : "contact:hertz_mindlin");
+  if (model.contact.damping_normal > 0 || model.contact.damping_shear > 0)
+    modules.push_back("damping:viscous");
+  if (model.contact.local_damping > 0) modules.push_back("damping:local");
+  const std::pair<sim::WallShape, const char*> shapes[] = {
+      {sim::WallShape::Plane, "walls:plane"},
+      {sim::WallShape::Polygon, "walls:polygon"},
+      {sim::WallShape::Mesh, "walls:mesh"}};
+  auto anyWall = [&model](auto predicate) {
+    return std::any_of(model.walls.begin(), model.walls.end(), predicate);
+  };
+  for (const auto& [shape, name] : shapes)
+    if (anyWall([shape = shape](const sim::Wall& w) { return w.shape == shape; }))
+      modules.push_back(name);
+  if (anyWall([](const sim::Wall& w) { return !w.motion.isStatic(); }))
+    modules.push_back("walls:moving");
+  if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
+  if (world.particles().clumps.size() > 0) modules.push_back("clumps");
+  if (has_experiment) modules.push_back("experiment:" + scene.experiment_type);
+  if (!scene.cameras.empty())
+    modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");
+  if (scene.run.hdf5) modules.push_back("output:hdf5");
+  if (scene.run.vtk) modules.push_back("output:vtk");
+  if (scene.run.checkpoint) modules.push_back("output:checkpoint");
+  return modules;
+}
+
+/// The set-up lines of the log: scene, modules, clump shapes, time-step audit, steps.
+void logSetup(const Scene& scene, const RunSetup& setup, const RunOptions& options,
+              std::ostream& log) {
+  const sim::World& world = *setup.world;
+  const sim::Model& model = world.model();
+  log << "rocklab: scene '" << scene.run.name << "'"
+      << (options.restart.empty() ? "" : " (restart)") << ", " << world.particles().size()
+      << " balls (" << world.particles().clumps.size() << " clumps), " << model.walls.size()
+      << " walls, threads: " << world.threads() << "\n";
+  log << "  modules: ";
+  for (std::size_t k = 0; k < setup.modules.size(); ++k) log << (k ? ", " : "") << setup.modules[k];
+  log << "\n";
+  for (const ClumpShapeReport& c : scene.clump_shapes)
+    log << "  clump shape of " << c.source << ": " << c.shape << ", " << c.members
+        << " members, mass " << c.mass * 1e3 << " g (" << c.distribution
+        << " distribution), volume " << c.volume * 1e9 << " mm^3 (equivalent diameter "
+        << c.equivalent_diameter * 1e3 << " mm); true union volume " << c.union_volume * 1e9
+        << " +- " << c.union_volume_error * 1e9 << " mm^3\n";
+  log << world.timestepAudit().describe(model.timestep) << "\n";
+  log << "  steps: " << setup.total_steps << " from t = " << world.time() << " s, output to "
+      << options.out_dir.string() << "\n";
+}
+
+/// The scene's cameras (the GL context is made here, only when there is one),
+/// the experiment's tracking camera handing it its raw frames.
+int makeCameras(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup) {
+  try {
+    for (const CameraSettings& c : scene.cameras)
+      setup.cameras.push_back(std::make_unique<CameraRecorder>(c, scene, options.out_dir, log));
+  } catch (const std::exception& e) {
+    log << "error: camera: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  Experiment* experiment = setup.experiment.get();
+  if (experiment && !experiment->trackingCamera().empty())
+    for (auto& c : setup.cameras)
+      if (c->settings().name == experiment->trackingCamera())
+        c->on_frame = [experiment](std::uint64_t frame, double time, const cv::Mat& raw) {
+          experiment->cameraFrame(frame, time, raw);
+        };
+  return kExitOk;
+}
+
+}  // namespace
+
+int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup) {
+  if (const int rc = makeWorld(scene, options, log, setup.world); rc != kExitOk) return rc;
+  setup.experiment = makeExperiment(scene);
+  if (setup.experiment && !options.restart.empty()) {
+    log << "error: " << scene.source.string() << ": experiment." << scene.experiment_type
+        << " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not "
+           "saved); run the scene again\n";
+    return kExitBadInput;
+  }
+  countSteps(scene, setup.world->dt(), setup);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  if (ec) {
+    log << "error: cannot create output directory " << options.out_dir << ": " << ec.message()
+        << "\n";
+    return kExitBadInput;
+  }
+  setup.modules = activeModules(scene, *setup.world, setup.experiment != nullptr);
+  logSetup(scene, setup, options, log);
+  if (const int rc = makeCameras(scene, options, log, setup); rc != kExitOk) return rc;
+  if (scene.run.hdf5)
+    setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);
+  if (scene.run.vtk)
+    setup.vtk = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "particles");
+  return kExitOk;
+}
+
+}  // namespace rocklab::experiments::detail

@@ -1,0 +1,68 @@
+// Scene reader: [[cameras]] (also the camera files of `rocklab render`).
+#include <cmath>
+
+#include "scene/scene_internal.h"
+
+namespace rocklab::experiments::detail {
+
+/// [[cameras]]: intrinsics (fov_deg, or fx/fy/cx/cy), pose (eye, target, up),
+/// timing and outputs. Every camera field is checked by
+/// geometry::Camera::validate.
+void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
+  for (TableReader t : root.tableArray("cameras")) {
+    CameraSettings c;
+    c.name = t.string("name", "camera" + std::to_string(cameras.size()));
+    for (const auto& other : cameras)
+      if (other.name == c.name) t.fail("name", "another camera has this name");
+    std::vector<double> res = t.numberList("resolution", Range::closed(16, 8192));
+    if (res.empty()) res = {640, 480};
+    if (res.size() != 2 || res[0] != std::floor(res[0]) || res[1] != std::floor(res[1]))
+      t.fail("resolution", "expected [width, height] in whole pixels, 16..8192");
+    const int w = static_cast<int>(res[0]), h = static_cast<int>(res[1]);
+    geometry::Camera& cam = c.camera;
+    if (t.has("fov_deg")) {
+      if (t.has("fx")) t.fail("fx", "give fov_deg or fx/fy/cx/cy, not both");
+      cam = geometry::Camera::withFieldOfView(w, h,
+                                              t.number("fov_deg", 60, {0.0, 179.0, true, false}));
+    } else {
+      cam.width = w;
+      cam.height = h;
+      cam.fx = t.requiredNumber("fx", Range::positive());
+      cam.fy = t.number("fy", cam.fx, Range::positive());
+      cam.cx = t.number("cx", 0.5 * (w - 1));
+      cam.cy = t.number("cy", 0.5 * (h - 1));
+    }
+    cam.k1 = t.number("k1", 0.0);
+    cam.k2 = t.number("k2", 0.0);
+    cam.frameRate = t.number("frame_rate", 500.0, Range::positive());
+    cam.exposureTime = t.number("exposure", 0.0, Range::nonNegative());
+    const Vec3 eye = t.requiredVec3("eye"), target = t.requiredVec3("target");
+    try {
+      cam.lookAt(eye, target, t.vec3("up", Vec3::UnitZ()));
+    } catch (const std::invalid_argument& e) {
+      t.fail("up", e.what());
+    }
+    try {
+      cam.validate();
+    } catch (const std::invalid_argument& e) {
+      t.fail("exposure", e.what());
+    }
+    c.start_time = t.number("start_time", c.start_time, Range::nonNegative());
+    c.end_time = t.number("end_time", c.end_time, Range::positive());
+    c.movie = t.boolean("movie", c.movie);
+    c.movie_fps = t.number("movie_fps", c.movie_fps, Range::closed(1, 1000));
+    c.still_interval = t.number("still_interval", c.still_interval, Range::nonNegative());
+    c.all_frames = t.boolean("all_frames", c.all_frames);
+    c.timestamp = t.boolean("timestamp", c.timestamp);
+    c.scale_bar = t.boolean("scale_bar", c.scale_bar);
+    c.scale_depth = t.number("scale_depth", (target - eye).norm(), Range::positive());
+    c.motion_blur = t.boolean("motion_blur", c.motion_blur);
+    c.noise_sigma = t.number("noise_sigma", c.noise_sigma, Range::closed(0, 100));
+    c.light_gain = t.number("light_gain", c.light_gain, Range::closed(0, 10));
+    if (c.motion_blur && !(cam.exposureTime > 0)) t.fail("motion_blur", "needs exposure > 0 s");
+    t.finish();
+    cameras.push_back(c);
+  }
+}
+
+}  // namespace rocklab::experiments::detail

@@ -1,0 +1,26 @@
+// Scene reader: [experiment], its type and the keys its driver reads.
+#include "drivers/registry.h"
+#include "scene/scene_internal.h"
+
+namespace rocklab::experiments::detail {
+
+/// The [experiment] table: its type, and its keys read and checked by that
+/// type's driver; nothing for a plain run.
+void readExperiment(TableReader& root, Scene& scene) {
+  auto t = root.table("experiment");
+  if (!t) return;
+  std::vector<std::string> types;
+  for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
+  scene.experiment_type = t->requiredString("type", types);
+  const double check_interval =
+      t->number("check_interval", ExperimentSettings{}.check_interval, Range::positive());
+  // The driver reads and checks the keys of its type into its settings
+  // (drivers/registry.cpp).
+  auto settings = findExperimentDriver(scene.experiment_type)
+                      ->read_settings(*t, SettingsContext{scene.model, scene.cameras});
+  settings->check_interval = check_interval;
+  t->finish();
+  scene.experiment = std::move(settings);
+}
+
+}  // namespace rocklab::experiments::detail

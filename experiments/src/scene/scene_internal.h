@@ -1,0 +1,46 @@
+#pragma once
+// The scene reader's table groups, one file each, private to the library:
+// scene.cpp (the top-level reader, `extends`, --set), scene_output.cpp
+// ([scene], [output]), scene_materials.cpp ([materials.NAME], [contact]),
+// scene_engine.cpp
+// ([gravity], [timestep], [neighbours], [watchdog], [relaxation]),
+// scene_walls.cpp ([[walls]]), scene_particles.cpp ([[particles]]),
+// scene_cameras.cpp ([[cameras]]), scene_experiment.cpp ([experiment]).
+// Each reads its keys with the TableReader (file:line messages) in the order
+// readScene calls them, which is the order of the messages.
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rocklab/experiments/scene.h"
+#include "scene/toml_reader.h"
+
+namespace rocklab::experiments::detail {
+
+using geometry::Vec3;
+
+void readRunTable(TableReader& root, RunSettings& run);
+void readOutput(TableReader& root, RunSettings& run);
+
+/// Material name -> index into model.materials.
+std::map<std::string, int> readMaterials(TableReader& root, Scene& scene);
+void readContact(TableReader& root, sim::Model& model);
+/// An RGB colour [r, g, b] with channels in [0, 1].
+render::Rgb readColour(TableReader& t, const std::string& key, render::Rgb fallback);
+/// The index of the table's `material` key among `materials`.
+int materialIndex(TableReader& t, const std::map<std::string, int>& materials);
+
+void readGravity(TableReader& root, sim::Model& model);
+void readEngine(TableReader& root, sim::Model& model);
+
+void readWalls(TableReader& root, const std::map<std::string, int>& materials,
+               const std::filesystem::path& base_dir, sim::Model& model,
+               std::vector<WallLook>& looks);
+void readParticles(TableReader& root, const std::map<std::string, int>& materials,
+                   const std::vector<sim::Material>& material_list, std::uint64_t seed,
+                   const std::filesystem::path& base_dir, Scene& scene);
+void readCameras(TableReader& root, std::vector<CameraSettings>& cameras);
+void readExperiment(TableReader& root, Scene& scene);
+
+}  // namespace rocklab::experiments::detail
