@@ -273,8 +273,9 @@ struct World::Impl {
   void checkNetworkStep();
   template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
   std::string stepAdvice() const;
-  // On demand (particle_stress.cpp): the contacts' share of World::particleStress.
+  // On demand (contact_measures.cpp): World::particleStress, World::wallForces.
   template <class Law> void contactStress(std::vector<geometry::Mat3>& sum) const;
+  template <class Law> std::vector<Vec3> wallLoads() const;
   // 8. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)
   void integrateStage(const StepPlan& plan, StepChecks& checks);
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);

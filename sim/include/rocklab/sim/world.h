@@ -135,6 +135,10 @@ class World {
   /// elastic contact force (normal and shear springs, no dashpots) or the bond
   /// force of the last step. Computed on demand (not in the step).
   std::vector<geometry::Mat3> particleStress() const;
+  /// Force (N) the balls exert on each wall (index = Model::walls), from the
+  /// elastic contact forces of the last step (no dashpots: with contact damping
+  /// the dashpots' share is left out). A platen's load cell.
+  std::vector<Vec3> wallForces() const;
 
   /// Adds forces other than contacts (force_contribution.h); called in the
   /// `extra forces` stage in the order added. A world with contributions no

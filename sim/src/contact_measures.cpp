@@ -1,5 +1,7 @@
-// The average stress of each ball (World::particleStress, dem-models.md §11)
-// and its principal values (particle_stress.h).
+// Measurements on demand from the contacts of the last step: the average
+// stress of each ball (World::particleStress, dem-models.md §11) with its
+// principal values (particle_stress.h), and the load on each wall
+// (World::wallForces).
 #include "rocklab/sim/particle_stress.h"
 
 #include <Eigen/Eigenvalues>
@@ -36,6 +38,29 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 }
 
 }  // namespace
+
+template <class Law>
+std::vector<Vec3> World::Impl::wallLoads() const {
+  std::vector<Vec3> load(model.walls.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
+      if (!history.wall_touch[c]) continue;
+      const std::uint32_t wk = nb.wall_index[c];
+      ContactPoint touch;
+      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
+      const double overlap = wallOverlap(touch, c);
+      if (overlap <= 0) continue;
+      double secant, tangent;
+      Law::normal(wallProps(i, wk), overlap, p.radius[i], secant, tangent);
+      load[wk] -= history.wall_shear[c] - secant * overlap * touch.normal;  // minus the force on the ball
+    }
+  return load;
+}
+
+std::vector<Vec3> World::wallForces() const {
+  return impl_->model.contact.law == ContactLaw::Linear ? impl_->wallLoads<detail::LinearLaw>()
+                                                        : impl_->wallLoads<detail::HertzMindlinLaw>();
+}
 
 template <class Law>
 void World::Impl::contactStress(std::vector<Mat3>& sum) const {
