@@ -66,6 +66,7 @@ TEST_CASE("bad input: exit code 2 and the previous outputs are untouched", "[cli
   CHECK(cli({"run", kScene, "--out", out.string(), "--set", "timestep.safety_factor=7"}) == 2);
   CHECK(cli({"run", kScene, "--out", out.string(), "--set", "timestep.dt=1"}) == 2);
   CHECK(cli({"run", "/no/such/scene.toml", "--out", out.string()}) == 2);
+  CHECK(cli({"check", "heap", "--set", "experiment.check_interval=0.002"}) == 2);  // renamed key
   CHECK(cli({"restart", "/no/such/checkpoint.h5", "--out", out.string()}) == 2);
   CHECK(slurp(out / "results.json") == "{\"previous\": true}\n");
   CHECK(!fs::exists(out / "run.h5"));

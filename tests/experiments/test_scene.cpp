@@ -52,6 +52,16 @@ TEST_CASE("unknown key: file - line and the known keys", "[scene]") {
                       Contains("safety_factor"));
 }
 
+TEST_CASE("the renamed experiment.check_interval names its new key", "[scene]") {
+  // Seconds under [experiment], steps under [watchdog]: the old name is refused with the new.
+  CHECK_THAT(errorOf(kMinimal + "\n[experiment]\ntype = \"drop\"\ncheck_interval = 0.002\n"),
+             Contains("bad.toml:18: key 'experiment.check_interval' = 0.002: renamed to "
+                      "experiment.sample_interval (seconds)"));
+  const Scene s = loadSceneText(
+      kMinimal + "\n[experiment]\ntype = \"drop\"\nsample_interval = 0.004\n", "ok.toml");
+  CHECK(s.experiment->sample_interval == 0.004);
+}
+
 TEST_CASE("wrong type: names the key - the value and the allowed values", "[scene]") {
   CHECK_THAT(errorOf(kMinimal + "\n[timestep]\nsafety_factor = \"fast\"\n"),
              Contains("bad.toml:17: key 'timestep.safety_factor' = \"fast\": expected a number") &&

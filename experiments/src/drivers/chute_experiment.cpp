@@ -6,7 +6,7 @@
 //            marker positions (5 columns x 4 against the camera wall, §c DEM 2);
 //   tilt     gravity at the test inclination, gate still closed, tilt_steps
 //            steps (the study's 5000 cycles of settling after the tilt, §c DEM 3);
-//   flow     gate removed; every check_interval (500 fps like the lab camera)
+//   flow     gate removed; every sample_interval (500 fps like the lab camera)
 //            the markers' travel along the base is sampled, and bodies past the
 //            outlet are counted as discharged; bodies remove_beyond past the
 //            outlet are deleted. Ends when every body is out (clearance) or
@@ -87,7 +87,7 @@ class ChuteExperiment final : public Experiment {
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     if (phase_ == Phase::Start) {
       every_ =
-          static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
+          static_cast<std::uint64_t>(std::max(1.0, std::round(e_.sample_interval / world->dt())));
       switchPhase(world, ctx, [&](sim::Model& m) {
         m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
         m.gravity_changes.clear();  // the experiment owns gravity

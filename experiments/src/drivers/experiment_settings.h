@@ -17,7 +17,7 @@ using detail::TableReader;
 /// The keys of [experiment] every type has (read by the scene reader).
 struct ExperimentSettings {
   virtual ~ExperimentSettings() = default;
-  double check_interval = 0.002;  // s between the driver's samples (the lab filmed at 500 fps)
+  double sample_interval = 0.002;  // s between the driver's samples (the lab filmed at 500 fps)
 };
 
 /// The settings of `scene`'s experiment as its driver's type (the registry pairs
@@ -34,7 +34,7 @@ struct SettingsContext {
 };
 
 /// Settling (heap; chute deposition; the coming Zwick and crusher feeds): settled
-/// when no body is faster than `speed`, looked at every check_interval, not before
+/// when no body is faster than `speed`, looked at every sample_interval, not before
 /// min_time (drivers/settle.h).
 struct SettleSettings {
   double speed = 0.02;    // m/s

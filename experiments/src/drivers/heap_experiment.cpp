@@ -34,7 +34,7 @@ class HeapExperiment final : public Experiment {
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext&) override {
     const auto every =
-        static_cast<std::uint64_t>(std::max(1.0, std::round(e_.check_interval / world->dt())));
+        static_cast<std::uint64_t>(std::max(1.0, std::round(e_.sample_interval / world->dt())));
     if (world->stepCount() % every != 0) return true;
     const double t = world->time();
     if (!settle_.over(*world)) return true;

@@ -12,13 +12,17 @@ void readExperiment(TableReader& root, Scene& scene) {
   std::vector<std::string> types;
   for (const ExperimentDriver& d : experimentDrivers()) types.push_back(d.type);
   scene.experiment_type = t->requiredString("type", types);
-  const double check_interval =
-      t->number("check_interval", ExperimentSettings{}.check_interval, Range::positive());
+  // The key was check_interval, the name [watchdog] gives a count of steps: a
+  // scene still using it is told the new name rather than "unknown key".
+  if (t->has("check_interval"))
+    t->fail("check_interval", "renamed to experiment.sample_interval (seconds)");
+  const double sample_interval =
+      t->number("sample_interval", ExperimentSettings{}.sample_interval, Range::positive());
   // The driver reads and checks the keys of its type into its settings
   // (drivers/registry.cpp).
   auto settings = findExperimentDriver(scene.experiment_type)
                       ->read_settings(*t, SettingsContext{scene.model, scene.cameras});
-  settings->check_interval = check_interval;
+  settings->sample_interval = sample_interval;
   t->finish();
   scene.experiment = std::move(settings);
 }
