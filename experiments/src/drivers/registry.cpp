@@ -3,6 +3,7 @@
 #include "drivers/chute_experiment.h"
 #include "drivers/drop_experiment.h"
 #include "drivers/heap_experiment.h"
+#include "drivers/zwick_experiment.h"
 
 namespace rocklab::experiments {
 
@@ -11,6 +12,7 @@ const std::vector<ExperimentDriver>& experimentDrivers() {
       {"drop", readDropSettings, makeDropExperiment},
       {"heap", readHeapSettings, makeHeapExperiment},
       {"chute", readChuteSettings, makeChuteExperiment},
+      {"zwick", readZwickSettings, makeZwickExperiment},
   };
   return drivers;
 }

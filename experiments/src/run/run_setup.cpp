@@ -21,8 +21,8 @@ int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
       out::Checkpoint cp = out::readCheckpoint(options.restart);
       world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
     } else {
-      world =
-          std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, options.threads);
+      world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, scene.bonds,
+                                           options.threads);
     }
   } catch (const out::CheckpointError& e) {
     log << "error: " << e.what() << "\n";
@@ -75,6 +75,7 @@ std::vector<std::string> activeModules(const Scene& scene, const sim::World& wor
     modules.push_back("walls:moving");
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
   if (world.particles().clumps.size() > 0) modules.push_back("clumps");
+  if (world.bonds().size() > 0) modules.push_back("bonds:parallel");
   if (has_experiment) modules.push_back("experiment:" + scene.experiment_type);
   if (!scene.cameras.empty())
     modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");

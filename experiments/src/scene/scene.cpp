@@ -29,6 +29,7 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   detail::readEngine(root, scene.model);
   detail::readWalls(root, materials, base_dir, scene.model, scene.wall_looks);
   detail::readParticles(root, materials, scene.model.materials, scene.run.seed, base_dir, scene);
+  detail::readBonds(root, scene.run.seed, scene);
   detail::readCameras(root, scene.cameras);
   detail::readExperiment(root, scene);
   detail::readOutput(root, scene.run);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rocklab/experiments/scene.h"
+#include "rocklab/geometry/packing.h"
 #include "scene/toml_reader.h"
 
 namespace rocklab::experiments::detail {
@@ -40,6 +41,13 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
 void readParticles(TableReader& root, const std::map<std::string, int>& materials,
                    const std::vector<sim::Material>& material_list, std::uint64_t seed,
                    const std::filesystem::path& base_dir, Scene& scene);
+/// One [[particles]] source of type "agglomerate" (scene_agglomerates.cpp):
+/// its balls into scene.spheres, its bonded pairs into scene.bonds (strengths
+/// set by readBonds), its report into scene.agglomerates.
+void readAgglomerate(TableReader& t, int material, geometry::Rng& rng, Scene& scene);
+/// [bonds]: the parallel-bond model and the strengths of the agglomerates' bonds
+/// (constant, or Weibull per bond or per agglomerate, seeded).
+void readBonds(TableReader& root, std::uint64_t seed, Scene& scene);
 void readCameras(TableReader& root, std::vector<CameraSettings>& cameras);
 void readExperiment(TableReader& root, Scene& scene);
 

@@ -123,8 +123,17 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
   // Every ball placed so far (clump members in world position), for insertion.
   std::vector<geometry::Sphere> placed;
   for (TableReader t : root.tableArray("particles")) {
-    const std::string type = t.requiredString("type", {"lattice", "random", "list"});
+    const std::string type = t.requiredString("type", {"lattice", "random", "list", "agglomerate"});
     const int material = materialIndex(t, materials);
+    if (type == "agglomerate") {
+      geometry::Rng agglomerate_rng(seed * 1000003ull + source_index);
+      readAgglomerate(t, material, agglomerate_rng, scene);
+      for (std::size_t k = scene.agglomerates.back().first_ball; k < spheres.size(); ++k)
+        placed.push_back({spheres[k].position, spheres[k].radius});
+      t.finish();
+      ++source_index;
+      continue;
+    }
     const Vec3 velocity = t.vec3("velocity", Vec3::Zero());
     const std::string shape = t.string("shape", "sphere", {"sphere", "four_ball", "file"});
     // Each source has its own stream, so adding a source does not move the

@@ -52,6 +52,20 @@ struct ClumpShapeReport {
   geometry::Vec3 principal_inertia = geometry::Vec3::Zero();  // kg m^2
 };
 
+/// One bonded agglomerate of the scene ([[particles]] type = "agglomerate"):
+/// its balls are scene.spheres[first_ball, first_ball + balls), its bonds
+/// scene.bonds[first_bond, first_bond + bonds).
+struct AgglomerateReport {
+  std::string source;           // particles.N
+  std::string method;           // "hcp" or "library"
+  std::size_t first_ball = 0, balls = 0, first_bond = 0, bonds = 0;
+  double diameter = 0;          // m, of the bounding sphere
+  double porosity = 0;          // -, against the bounding sphere
+  double coordination_number = 0;  // bonds per ball (x 2)
+  double solid_volume = 0;      // m^3
+  double bond_strength = 0;     // Pa, the agglomerate's own (constant or drawn) strength; 0 = per bond
+};
+
 /// A virtual camera of the scene ([[cameras]]): frames are rendered only at its
 /// frame times, never every step. A scene without cameras never creates a GL context.
 struct CameraSettings {
@@ -87,6 +101,8 @@ struct Scene {
   std::vector<sim::SphereSpec> spheres;
   std::vector<sim::ClumpSpec> clumps;
   std::vector<ClumpShapeReport> clump_shapes;
+  std::vector<sim::BondSpec> bonds;  // parallel bonds between scene.spheres (model.bonds)
+  std::vector<AgglomerateReport> agglomerates;
   RunSettings run;
   std::string experiment_type;  // "" (plain run) or a registered driver's type
   std::shared_ptr<const ExperimentSettings> experiment;  // its settings (null for a plain run)

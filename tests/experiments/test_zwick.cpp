@@ -1,0 +1,114 @@
+// The Zwick crushing test (experiments.md §e, §f) on a small HCP agglomerate,
+// and the scene's agglomerate and [bonds] tables.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "rocklab/experiments/run.h"
+#include "rocklab/experiments/scene.h"
+
+namespace fs = std::filesystem;
+using namespace rocklab::experiments;
+using json = nlohmann::json;
+
+namespace {
+
+const std::string kZwick = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/zwick-hcp.toml";
+
+/// A 16 mm agglomerate (dozens of spheres) closed 6x faster than Table 5.2: seconds, not minutes.
+const std::vector<std::string> kSmall = {
+    "particles.0.diameter=0.016", "particles.0.position=[0,0,0.009]",
+    "experiment.platen_speed=0.05", "experiment.sample_interval=1e-5"};
+
+std::string sceneError(const std::vector<std::string>& overrides) {
+  try {
+    loadScene(kZwick, overrides);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+}  // namespace
+
+TEST_CASE("zwick: a small bonded agglomerate shows a peak and a drop, and loses no mass",
+          "[experiment][zwick]") {
+  const Scene scene = loadScene(kZwick, kSmall);
+  REQUIRE(scene.agglomerates.size() == 1);
+  REQUIRE(scene.bonds.size() == scene.agglomerates[0].bonds);
+  CHECK(scene.agglomerates[0].coordination_number > 4);
+  const fs::path dir = fs::temp_directory_path() / "rocklab-zwick-small";
+  fs::remove_all(dir);
+  RunOptions options;
+  options.out_dir = dir;
+  options.threads = 2;
+  options.progress = false;
+  std::ostringstream log;
+  REQUIRE(runScene(scene, options, log) == kExitOk);
+  INFO(log.str());
+  std::ifstream in(dir / "results.json");
+  const json r = json::parse(in);
+  const json& z = r["zwick"];
+  CHECK(z["failed"].get<bool>());
+  const double peak = r["peak_force_N"].get<double>();
+  CHECK(peak > 100.0);
+  CHECK(r["bonds_broken"].get<std::size_t>() > 0);
+  CHECK(r["sphere_count"].get<std::size_t>() == scene.spheres.size());
+  // Eq 5-1 from the reported peak and gap.
+  const double gap = z["platen_gap_at_peak_m"].get<double>();
+  CHECK(r["strength_MPa"].get<double>() == Approx(peak / (gap * gap) * 1e-6));
+  CHECK(gap < z["specimen_height_m"].get<double>());
+  // The curve: rises to the peak, then drops below half of it (the test's end).
+  std::ifstream csv(dir / "force_displacement.csv");
+  std::string line;
+  std::getline(csv, line);
+  double last_force = 0, max_force = 0;
+  while (std::getline(csv, line)) {
+    std::stringstream row(line);
+    std::string cell;
+    for (int c = 0; c < 4; ++c) std::getline(row, cell, ',');
+    last_force = std::stod(cell);
+    max_force = std::max(max_force, last_force);
+  }
+  CHECK(max_force == Approx(peak));
+  CHECK(last_force < 0.5 * peak);
+  // Fragments share out the whole volume: nothing is lost.
+  const json& f = r["fragments"];
+  CHECK(f["largest_fraction"].get<double>() < 2.0 / 3.0);
+  CHECK(f["count"].get<std::size_t>() > 1);
+  CHECK(fs::exists(dir / "force_displacement.png"));
+  CHECK(fs::exists(dir / "bond_breaks.csv"));
+}
+
+TEST_CASE("zwick: bonds of constant or Weibull strength; bad bond and platen keys are refused",
+          "[experiment][zwick]") {
+  const Scene constant = loadScene(kZwick, kSmall);
+  for (const auto& b : constant.bonds) CHECK(b.tensile_strength == 60e6);
+  const Scene per_agglomerate = loadScene(
+      kZwick,
+      {"bonds.strength_distribution=\"weibull_per_agglomerate\"", "bonds.weibull_modulus=3"});
+  const double drawn = per_agglomerate.bonds.front().tensile_strength;
+  CHECK(drawn != 60e6);
+  for (const auto& b : per_agglomerate.bonds) CHECK(b.tensile_strength == drawn);
+  CHECK(per_agglomerate.agglomerates[0].bond_strength == drawn);
+  const Scene per_bond = loadScene(
+      kZwick, {"bonds.strength_distribution=\"weibull_per_bond\"", "bonds.weibull_modulus=3"});
+  CHECK(per_bond.bonds[0].tensile_strength != per_bond.bonds[1].tensile_strength);
+  // Seeded: the same scene gives the same draws.
+  CHECK(loadScene(kZwick,
+                  {"bonds.strength_distribution=\"weibull_per_bond\"", "bonds.weibull_modulus=3"})
+            .bonds[5]
+            .tensile_strength == per_bond.bonds[5].tensile_strength);
+
+  CHECK_THAT(sceneError({"bonds.normal_stiffness=-1"}), Catch::Contains("bonds.normal_stiffness"));
+  CHECK_THAT(sceneError({"bonds.strength_distribution=\"weibull_per_bond\""}),
+             Catch::Contains("weibull_modulus"));
+  CHECK_THAT(sceneError({"bonds.weibull_modulus=3"}),
+             Catch::Contains("only with strength_distribution"));
+  CHECK_THAT(sceneError({"experiment.top_platen=\"lid\""}),
+             Catch::Contains("no wall called 'lid'"));
+  CHECK_THAT(sceneError({"particles.0.hcp_angle=120"}), Catch::Contains("hcp_angle"));
+  CHECK_THAT(sceneError({"particles.0.diameter=0.004"}), Catch::Contains("two sphere radii"));
+}
