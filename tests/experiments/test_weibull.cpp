@@ -2,7 +2,13 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "analysis/weibull.h"
+#include "analysis/weibull_report.h"
 
 using namespace rocklab;
 
@@ -70,4 +76,33 @@ TEST_CASE("weibull: power-law size effect and bad input", "[weibull]") {
   CHECK(fit.r2 == Approx(1.0));
   CHECK_THROWS_WITH(experiments::fitWeibull({1.0, 2.0}), Catch::Contains("at least 3"));
   CHECK_THROWS_WITH(experiments::fitWeibull({1.0, 2.0, -3.0}), Catch::Contains("strength -3 Pa"));
+}
+
+TEST_CASE("weibull: the batch command fits a sweep's strength column and refuses what it cannot use", "[weibull]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "rocklab-weibull-batch";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    std::ofstream csv(dir / "sweep.csv");
+    csv << "scene.seed,strength_MPa,status\n";
+    const double m = 3.0, s0 = 20.0;
+    for (int i = 1; i <= 20; ++i)
+      csv << i << ',' << s0 * std::pow(std::log(1.0 / (1.0 - i / 21.0)), 1.0 / m) << ",ok\n";
+    csv << "21,,exit 3\n";  // a failed run is left out
+  }
+  std::ostringstream log;
+  REQUIRE(experiments::weibullCommand(dir, "strength_MPa", log) == 0);
+  std::ifstream in(dir / "weibull.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["count"].get<int>() == 20);
+  CHECK(j["skipped_rows"].get<int>() == 1);
+  CHECK(j["weibull_m"].get<double>() == Approx(3.0));
+  CHECK(j["weibull_sigma0_MPa"].get<double>() == Approx(20.0));
+  CHECK(fs::exists(dir / "weibull.png"));
+  std::ostringstream bad;
+  CHECK(experiments::weibullCommand(dir, "peak_force_N", bad) == 2);
+  CHECK_THAT(bad.str(), Catch::Contains("no column 'peak_force_N'"));
+  CHECK(experiments::weibullCommand(dir / "missing", "strength_MPa", bad) == 2);
+  fs::remove_all(dir);
 }

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "analysis/weibull_report.h"
 #include "camera/render_run.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
@@ -88,6 +89,7 @@ namespace {
 /// Everything the command line can set: CLI11 fills it, the commands read it.
 struct CliArgs {
   std::string scene_arg, checkpoint_arg, run_file_arg, out_dir, camera_file, collect_dir;
+  std::string weibull_column = "strength_MPa";
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false, skip_complete = false;
@@ -188,6 +190,12 @@ void addCommands(CLI::App& app, CliArgs& a) {
   auto* collect = app.add_subcommand("collect", "Merge the finished runs of a sweep or study folder into its table, "
                                                 "plot and recommendation (failed and missing runs listed)");
   collect->add_option("dir", a.collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
+
+  auto* weibull = app.add_subcommand(
+      "weibull", "Weibull analysis of a batch of crushing runs (a sweep folder): weibull.json and the Weibull plot");
+  weibull->add_option("dir", a.collect_dir, "Folder of the batch's sweep (holds sweep.csv)")->required();
+  weibull->add_option("--column", a.weibull_column, "sweep.csv column with the strengths in MPa")
+      ->capture_default_str();
 
   auto* shape = app.add_subcommand("shape", "Mesh (STL/PLY/OBJ) -> checked mass properties and a clump of spheres with its error");
   shape->add_option("mesh", a.shape_options.mesh, "Mesh file (with --generate: the mesh file to write, .stl/.ply/.obj)")->required();
@@ -351,6 +359,7 @@ int runCli(int argc, const char* const* argv) {
 
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
+  if (app.got_subcommand("weibull")) return weibullCommand(a.collect_dir, a.weibull_column, std::cerr);
   if (app.got_subcommand("shape")) {
     a.shape_options.preview = !a.no_preview;
     return runShape(a.shape_options, std::cerr);

@@ -41,14 +41,10 @@ void readAgglomerate(TableReader& t, int material, geometry::Rng& rng, Scene& sc
     t.fail("radius", e.what());
   }
   if (body.size() > 2000000) t.fail("diameter", "gives more than 2e6 spheres");
-  // The agglomerate's frame -> world: a fixed rotation (deg about x, y, z) or a
-  // random one (seeded), then the centre.
-  geometry::Quat q = geometry::Quat::Identity();
-  const std::string orientation = t.string("orientation", "given", {"given", "random"});
-  if (orientation == "random")
-    q = geometry::randomRotation(rng);
-  else
-    q = rotationFromDegrees(t.vec3("rotation", Vec3::Zero()));
+  // The agglomerate's frame -> world: a fixed rotation (deg about x, y, z),
+  // followed by a random one (seeded) when orientation = "random", then the centre.
+  geometry::Quat q = rotationFromDegrees(t.vec3("rotation", Vec3::Zero()));
+  if (t.string("orientation", "given", {"given", "random"}) == "random") q = geometry::randomRotation(rng) * q;
   const Vec3 centre = t.requiredVec3("position");
   const Vec3 velocity = t.vec3("velocity", Vec3::Zero());
 
