@@ -23,7 +23,7 @@ enum class PackKind { Servo, Geometric };
 PackKind parsePackKind(const std::string& name);  // "servo" | "geometric"; invalid_argument
 const char* packKindName(PackKind kind);
 
-inline constexpr double kServoSolidFraction = 0.55;      // first guess of the count
+inline constexpr double kServoSolidFraction = 0.57;      // first guess of the count
 inline constexpr double kGeometricSolidFraction = 0.56;  // relaxedRandomPack converges below ~0.6
 inline constexpr double kRadiusBand = 0.02;              // of R: accepted wall radii
 inline constexpr int kMaxCountTrials = 4;

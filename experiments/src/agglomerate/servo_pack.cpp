@@ -100,23 +100,38 @@ ServoPackResult servoCompactedPack(const ServoPackParams& p) {
   sim::World world(compactionModel(p), balls, 1);
   world.addForceContribution(wall);
 
-  bool done = false;
+  // Phase 1 with the central body force (see the header), phase 2 without it.
+  // a = p_target / (rho phi R): the weight of a column from the centre to the wall.
+  const double expected_radius = p.radius * std::cbrt(static_cast<double>(p.count) / 0.6);
+  const double central = p.precompact_interior
+                             ? p.target_pressure / (p.material.density * 0.6 * expected_radius)
+                             : 0.0;
+  bool first_phase = central > 0, done = false;
+  wall->setCentralAcceleration(central);
   sim::Energy energy;
   auto observe = [&](const sim::Snapshot& s) {
     energy = s.energy;
     const double kinetic = energy.kinetic_translational + energy.kinetic_rotational;
     const double stored = energy.elastic + energy.potential_other;
+    const double fraction = first_phase ? p.first_phase_kinetic_fraction : p.kinetic_fraction;
     done =
         std::abs(wall->pressure() - p.target_pressure) < p.pressure_tolerance * p.target_pressure &&
-        kinetic < p.kinetic_fraction * stored;
+        kinetic < fraction * stored;
   };
   const auto interval = static_cast<std::uint64_t>(std::max(1, p.check_interval));
-  while (!done && world.stepCount() < p.max_steps) {
+  while (world.stepCount() < p.max_steps) {
+    if (done && !first_phase) break;
+    if (done) {
+      first_phase = done = false;
+      wall->setCentralAcceleration(0.0);
+      result.first_phase_steps = world.stepCount();
+    }
     if ((world.stepCount() + 1) % interval == 0)
       world.step(observe);
     else
       world.step();
   }
+  done = done && !first_phase;
   result.kinetic_energy = energy.kinetic_translational + energy.kinetic_rotational;
   result.elastic_energy = energy.elastic + energy.potential_other;
   result.pressure = wall->pressure();

@@ -47,6 +47,7 @@ void ServoWall::addForces(const sim::ForceInput& in, std::span<sim::Vec3> force,
   max_penetration_ = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const WallTouch t = touch(settings_.centre, radius_, p.position[i], p.radius[i]);
+    if (central_acceleration_ > 0) force[i] -= p.mass[i] * central_acceleration_ * t.normal;
     if (t.penetration <= 0) continue;
     // Mirror rule (dem-models §4.2): R~ = R_ball, the ball's own G and nu.
     const double c = sim::hertzCoefficient(settings_.shear_modulus, settings_.poisson, p.radius[i]);

@@ -23,6 +23,7 @@
 // every step from the contacts of that step (Hertz stiffens with load); without
 // contacts the wall closes at max_speed.
 //
+// Optionally also a body force towards the centre (setCentralAcceleration).
 // One thread, balls in index order: bitwise the same on any thread count.
 #include <cstddef>
 #include <span>
@@ -62,11 +63,14 @@ class ServoWall : public sim::ForceContribution {
   std::size_t contacts() const { return contacts_; }
   /// Largest ball-wall penetration of the last step (m).
   double maxPenetration() const { return max_penetration_; }
+  /// A body force pulling every ball towards the centre (m/s^2; 0 = none): the
+  /// first phase of the servo pack (servo_pack.h) compacts the interior with it.
+  void setCentralAcceleration(double a) { central_acceleration_ = a; }
 
  private:
   ServoWallSettings settings_;
   double radius_;
-  double pressure_ = 0.0, speed_ = 0.0, max_penetration_ = 0.0;
+  double pressure_ = 0.0, speed_ = 0.0, max_penetration_ = 0.0, central_acceleration_ = 0.0;
   std::size_t contacts_ = 0;
 };
 
