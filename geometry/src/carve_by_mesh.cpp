@@ -14,17 +14,6 @@ namespace rocklab::geometry {
 
 namespace {
 
-Vec3 volumeCentroid(const std::vector<Sphere>& spheres) {
-  Vec3 sum = Vec3::Zero();
-  double weight = 0;
-  for (const Sphere& s : spheres) {
-    const double w = s.radius * s.radius * s.radius;
-    sum += w * s.centre;
-    weight += w;
-  }
-  return sum / weight;
-}
-
 double meshSize(const TriangleMesh& mesh, const MeshMassProperties& props,
                 MeshSizeMeasure measure) {
   const ShapeDescriptors shape = shapeDescriptors(mesh, props);

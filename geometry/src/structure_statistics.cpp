@@ -15,6 +15,17 @@ double ballVolume(double r) {
 }
 }  // namespace
 
+Vec3 volumeCentroid(const std::vector<Sphere>& spheres) {
+  Vec3 sum = Vec3::Zero();
+  double weight = 0;
+  for (const Sphere& s : spheres) {
+    const double w = s.radius * s.radius * s.radius;
+    sum += w * s.centre;
+    weight += w;
+  }
+  return weight > 0 ? Vec3(sum / weight) : Vec3::Zero();
+}
+
 double lensVolume(const Sphere& a, const Sphere& b) {
   const double d = (a.centre - b.centre).norm();
   const double big = std::max(a.radius, b.radius), small = std::min(a.radius, b.radius);

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "agglomerate/agglomerate_cli.h"
 #include "analysis/weibull_report.h"
 #include "camera/render_run.h"
 #include "rocklab/experiments/run.h"
@@ -102,6 +103,7 @@ struct CliArgs {
   // shape
   ShapeOptions shape_options;
   bool no_preview = false;
+  AgglomerateOptions agglomerate_options;
 };
 
 void addRunOptions(CLI::App* c, CliArgs& a) {
@@ -217,6 +219,7 @@ void addCommands(CLI::App& app, CliArgs& a) {
   shape->add_option("--pile-clumps", a.shape_options.pile_clumps, "Clumps in the pile");
   shape->add_option("--pile-time", a.shape_options.pile_time, "Simulated time of the pile (s)");
   shape->add_flag("--no-preview", a.no_preview, "Do not render preview.png");
+  addAgglomerateCommand(app, a.agglomerate_options, a.no_preview);
 }
 
 int studyCommand(const CliArgs& a) {
@@ -363,6 +366,10 @@ int runCli(int argc, const char* const* argv) {
   if (app.got_subcommand("shape")) {
     a.shape_options.preview = !a.no_preview;
     return runShape(a.shape_options, std::cerr);
+  }
+  if (app.got_subcommand("agglomerate")) {
+    a.agglomerate_options.preview = !a.no_preview;
+    return runAgglomerate(a.agglomerate_options, std::cerr);
   }
   if (app.got_subcommand("render")) return renderRun({a.run_file_arg, a.camera_file, a.out_dir}, std::cerr);
   if (app.got_subcommand("study")) return studyCommand(a);

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/preview_renderer.h"
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "rocklab/experiments/run.h"
@@ -216,13 +217,8 @@ void writePreview(const std::filesystem::path& png, const geometry::TriangleMesh
                   const std::vector<Sphere>& spheres) {
   const geometry::AABB box = mesh.bounds();
   const double L = (box.hi - box.lo).maxCoeff();
-  const double shift = 0.6 * L;
-  geometry::Camera cam = geometry::Camera::withFieldOfView(960, 480, 40.0);
-  cam.lookAt(Vec3(0.0, -3.6 * L, 1.5 * L), Vec3::Zero(), Vec3::UnitZ());
-  render::RenderOptions ro;
-  ro.nearClip = 0.05 * L;
-  ro.farClip = 20 * L;
-  render::Renderer renderer(cam, ro);
+  const double shift = detail::sideBySideShift(L);
+  render::Renderer renderer = detail::sideBySideRenderer(L);
   render::FrameDescription f;
   f.background = render::kBackdrop;
   render::MeshInstance m;

@@ -31,6 +31,10 @@ struct StructureStatistics {
 StructureStatistics structureStatistics(const std::vector<Sphere>& spheres, double envelope_volume,
                                         double gap_tolerance);
 
+/// Centre of the spheres with their volumes as weights (the centre of mass of equal-
+/// density spheres, overlaps counted twice), m; the origin for no spheres.
+Vec3 volumeCentroid(const std::vector<Sphere>& spheres);
+
 /// Volume of the intersection of two spheres (the lens), m^3.
 double lensVolume(const Sphere& a, const Sphere& b);
 
