@@ -1,13 +1,18 @@
 // The Zwick crushing test (experiments.md §e, §f) on a small HCP agglomerate,
 // and the scene's agglomerate and [bonds] tables.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "agglomerate/agglomerate_library.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
+#include "rocklab/geometry/bond_pairs.h"
+#include "rocklab/geometry/hcp_packing.h"
 
 namespace fs = std::filesystem;
 using namespace rocklab::experiments;
@@ -111,4 +116,53 @@ TEST_CASE("zwick: bonds of constant or Weibull strength; bad bond and platen key
              Catch::Contains("no wall called 'lid'"));
   CHECK_THAT(sceneError({"particles.0.hcp_angle=120"}), Catch::Contains("hcp_angle"));
   CHECK_THAT(sceneError({"particles.0.diameter=0.004"}), Catch::Contains("two sphere radii"));
+}
+
+TEST_CASE("zwick: an agglomerate from a library brings its spheres and bonds into the scene",
+          "[experiment][zwick]") {
+  // A library of one agglomerate: a 20 mm HCP cluster (13 spheres) with its bonded pairs.
+  AgglomerateRecord a;
+  a.name = agglomerateGroupName(0);
+  a.method = "hcp";
+  a.r_max = 0.0025;
+  a.diameter = 0.02;
+  a.spheres = rocklab::geometry::hcpPacking(0.0025, 0.02, 0.0);
+  for (const auto& [i, j] : rocklab::geometry::bondPairs(a.spheres, 1e-3))
+    a.bonds.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)});
+  a.sphere_count = a.spheres.size();
+  a.bond_count = a.bonds.size();
+  const fs::path lib =
+      fs::temp_directory_path() / ("rocklab-zwick-lib-" + std::to_string(::getpid()) + ".h5");
+  writeAgglomerateLibrary(lib, {a});
+  std::ifstream in(kZwick);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string scene_text = text.str();
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = scene_text.find(from);
+    REQUIRE(at != std::string::npos);
+    scene_text.replace(at, from.size(), to);
+  };
+  replace("method = \"hcp\"",
+          "method = \"library\"\nlibrary = \"" + lib.string() + "\"\nindex = 0");
+  replace("radius = 0.0025 ", "# ");
+  replace("diameter = 0.042 ", "# ");
+  replace("hcp_angle = 0.0 ", "# ");
+  const Scene scene = loadSceneText(scene_text, "library.toml");
+  REQUIRE(scene.agglomerates.size() == 1);
+  CHECK(scene.spheres.size() == a.spheres.size());
+  REQUIRE(scene.bonds.size() == a.bonds.size());
+  REQUIRE(a.bonds.size() > 3);
+  CHECK(scene.bonds[3].a == a.bonds[3][0]);
+  CHECK(scene.bonds[3].b == a.bonds[3][1]);
+  CHECK(scene.agglomerates[0].method == "library:hcp");
+  // An index past the end is refused with the library's size.
+  scene_text.replace(scene_text.find("index = 0"), 9, "index = 4");
+  try {
+    loadSceneText(scene_text, "library.toml");
+    FAIL("index 4 of a one-agglomerate library was accepted");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("holds 1 agglomerates"));
+  }
+  fs::remove(lib);
 }

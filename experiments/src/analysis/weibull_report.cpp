@@ -29,7 +29,8 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
   const std::filesystem::path csv = dir / "sweep.csv";
   std::ifstream in(csv);
   if (!in) {
-    log << "error: " << csv.string() << ": cannot read (run a sweep over the batch first, e.g. --vary scene.seed=1,2,...)\n";
+    log << "error: " << csv.string()
+        << ": cannot read (run a sweep over the batch first, e.g. --vary scene.seed=1,2,...)\n";
     return kExitBadInput;
   }
   std::string line;
@@ -65,7 +66,8 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
   try {
     fit = fitWeibull(strengths);
   } catch (const std::invalid_argument& e) {
-    log << "error: " << csv.string() << ": " << e.what() << " (" << skipped << " rows without a value)\n";
+    log << "error: " << csv.string() << ": " << e.what() << " (" << skipped
+        << " rows without a value)\n";
     return kExitBadInput;
   }
   nlohmann::json j;
@@ -78,7 +80,8 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
   j["mean_MPa"] = fit.mean;
   j["stddev_MPa"] = fit.stddev;
   j["cov"] = fit.cov;
-  j["method"] = "mean rank P_s = 1 - i/(N+1) (Eq 5-2), least squares of ln ln(1/P_s) on ln sigma (Eq 5-4)";
+  j["method"] =
+      "mean rank P_s = 1 - i/(N+1) (Eq 5-2), least squares of ln ln(1/P_s) on ln sigma (Eq 5-4)";
   j["strengths_MPa"] = fit.sorted;
   detail::writeAtomically(dir / "weibull.json", j.dump(2) + "\n");
   PlotSeries points{"runs", {}, {}, PlotSeries::Style::Points};
@@ -100,9 +103,10 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
   spec.y_label = "ln ln(1 / P_s)";
   spec.series = {points, line_fit};
   writePlot(spec, dir / "weibull.png");
-  log << "weibull: " << fit.count << " strengths: m = " << fit.modulus << ", sigma0 = " << fit.sigma0
-      << " MPa, R^2 = " << fit.r2 << ", mean " << fit.mean << " MPa, CoV " << fit.cov << "; "
-      << (dir / "weibull.json").string() << ", " << (dir / "weibull.png").string() << "\n";
+  log << "weibull: " << fit.count << " strengths: m = " << fit.modulus
+      << ", sigma0 = " << fit.sigma0 << " MPa, R^2 = " << fit.r2 << ", mean " << fit.mean
+      << " MPa, CoV " << fit.cov << "; " << (dir / "weibull.json").string() << ", "
+      << (dir / "weibull.png").string() << "\n";
   return kExitOk;
 }
 

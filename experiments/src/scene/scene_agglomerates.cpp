@@ -1,8 +1,11 @@
 // Scene reader: [[particles]] of type "agglomerate", bonded spheres placed as
 // one body (experiments.md §f): the hexagonal close packing of the anisotropy
-// study (§f.3), every touching pair bonded.
+// study (§f.3), every touching pair bonded, or one agglomerate of a library
+// written by `rocklab agglomerate` (dense random packing §f.4, carved from a
+// scan §f.7, or HCP), with its bonds.
 #include <numbers>
 
+#include "agglomerate/agglomerate_library.h"
 #include "rocklab/geometry/bond_pairs.h"
 #include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/hcp_packing.h"
@@ -23,10 +26,11 @@ geometry::Quat rotationFromDegrees(const Vec3& deg) {
 
 }  // namespace
 
-void readAgglomerate(TableReader& t, int material, geometry::Rng& rng, Scene& scene) {
-  AgglomerateReport report;
-  report.source = t.path();
-  report.method = t.string("method", "hcp", {"hcp"});
+namespace {
+
+/// The spheres (agglomerate frame) and bonded pairs of an HCP source.
+void readHcp(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sphere>& body,
+             std::vector<geometry::SpherePair>& pairs) {
   const double radius = t.requiredNumber("radius", Range::positive());
   const double diameter = t.requiredNumber("diameter", Range::positive());
   if (diameter < 2 * radius) t.fail("diameter", "must be at least two sphere radii");
@@ -34,31 +38,70 @@ void readAgglomerate(TableReader& t, int material, geometry::Rng& rng, Scene& sc
   // between the stacking axis and y, which the platens of a test along y see.
   const double angle = t.number("hcp_angle", 0.0, Range::closed(0, 90));
   const double gap_tolerance = t.number("gap_tolerance", 1e-3, Range::closed(0, 0.5));
-  std::vector<geometry::Sphere> body;
   try {
     body = geometry::hcpPacking(radius, diameter, angle);
   } catch (const std::invalid_argument& e) {
     t.fail("radius", e.what());
   }
   if (body.size() > 2000000) t.fail("diameter", "gives more than 2e6 spheres");
+  pairs = geometry::bondPairs(body, gap_tolerance);
+  const geometry::StructureStatistics stats = geometry::structureStatistics(
+      body, std::numbers::pi / 6.0 * diameter * diameter * diameter, gap_tolerance);
+  report.diameter = diameter;
+  report.porosity = stats.porosity;
+  report.coordination_number = stats.coordination_number;
+}
+
+/// The same from agglomerate `index` of a library file (its own bonds).
+void readLibrary(TableReader& t, const std::filesystem::path& base_dir, AgglomerateReport& report,
+                 std::vector<geometry::Sphere>& body, std::vector<geometry::SpherePair>& pairs) {
+  const std::filesystem::path file = base_dir / t.requiredString("library");
+  std::vector<AgglomerateRecord> library;
+  try {
+    library = readAgglomerateLibrary(file);
+  } catch (const std::exception& e) {
+    t.fail("library", e.what());
+  }
+  const std::int64_t index = t.integer("index", 0, Range::closed(0, 1e9));
+  if (static_cast<std::size_t>(index) >= library.size())
+    t.fail("index", "the library " + file.string() + " holds " + std::to_string(library.size()) +
+                        " agglomerates (indices 0.." + std::to_string(library.size() - 1) + ")");
+  const AgglomerateRecord& a = library[static_cast<std::size_t>(index)];
+  body = a.spheres;
+  for (const auto& b : a.bonds) pairs.emplace_back(b[0], b[1]);
+  report.method = "library:" + a.method;
+  report.diameter = a.diameter;
+  report.porosity = a.porosity;
+  report.coordination_number = a.coordination_number;
+}
+
+}  // namespace
+
+void readAgglomerate(TableReader& t, int material, const std::filesystem::path& base_dir,
+                     geometry::Rng& rng, Scene& scene) {
+  AgglomerateReport report;
+  report.source = t.path();
+  report.method = t.string("method", "hcp", {"hcp", "library"});
+  std::vector<geometry::Sphere> body;
+  std::vector<geometry::SpherePair> pairs;
+  if (report.method == "hcp")
+    readHcp(t, report, body, pairs);
+  else
+    readLibrary(t, base_dir, report, body, pairs);
   // The agglomerate's frame -> world: a fixed rotation (deg about x, y, z),
   // followed by a random one (seeded) when orientation = "random", then the centre.
   geometry::Quat q = rotationFromDegrees(t.vec3("rotation", Vec3::Zero()));
-  if (t.string("orientation", "given", {"given", "random"}) == "random") q = geometry::randomRotation(rng) * q;
+  if (t.string("orientation", "given", {"given", "random"}) == "random")
+    q = geometry::randomRotation(rng) * q;
   const Vec3 centre = t.requiredVec3("position");
   const Vec3 velocity = t.vec3("velocity", Vec3::Zero());
 
-  const std::vector<geometry::SpherePair> pairs = geometry::bondPairs(body, gap_tolerance);
-  const geometry::StructureStatistics stats = geometry::structureStatistics(
-      body, std::numbers::pi / 6.0 * diameter * diameter * diameter, gap_tolerance);
   report.first_ball = scene.spheres.size();
   report.balls = body.size();
   report.first_bond = scene.bonds.size();
   report.bonds = pairs.size();
-  report.diameter = diameter;
-  report.porosity = stats.porosity;
-  report.coordination_number = stats.coordination_number;
-  report.solid_volume = stats.solid_volume;
+  for (const geometry::Sphere& s : body)
+    report.solid_volume += 4.0 / 3.0 * std::numbers::pi * std::pow(s.radius, 3);
   for (const geometry::Sphere& s : body) {
     sim::SphereSpec spec;
     spec.position = centre + q * s.centre;

@@ -44,7 +44,8 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
 /// One [[particles]] source of type "agglomerate" (scene_agglomerates.cpp):
 /// its balls into scene.spheres, its bonded pairs into scene.bonds (strengths
 /// set by readBonds), its report into scene.agglomerates.
-void readAgglomerate(TableReader& t, int material, geometry::Rng& rng, Scene& scene);
+void readAgglomerate(TableReader& t, int material, const std::filesystem::path& base_dir, geometry::Rng& rng,
+                     Scene& scene);
 /// [bonds]: the parallel-bond model and the strengths of the agglomerates' bonds
 /// (constant, or Weibull per bond or per agglomerate, seeded).
 void readBonds(TableReader& root, std::uint64_t seed, Scene& scene);

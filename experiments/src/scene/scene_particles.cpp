@@ -127,7 +127,7 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
     const int material = materialIndex(t, materials);
     if (type == "agglomerate") {
       geometry::Rng agglomerate_rng(seed * 1000003ull + source_index);
-      readAgglomerate(t, material, agglomerate_rng, scene);
+      readAgglomerate(t, material, base_dir, agglomerate_rng, scene);
       for (std::size_t k = scene.agglomerates.back().first_ball; k < spheres.size(); ++k)
         placed.push_back({spheres[k].position, spheres[k].radius});
       t.finish();
