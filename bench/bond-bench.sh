@@ -26,7 +26,7 @@ for t in 1 2; do
   dir="$out/bonds-$t"
   "$rocklab" run zwick-hcp --out "$dir" --threads "$t" --quiet \
     --set particles.0.diameter="$diameter" --set particles.0.position="[0,0,$diameter]" \
-    --set experiment.platen_speed=1e-9 --set scene.steps="$steps" --set output.hdf5=false >"$dir.log" 2>&1 ||
+    --set experiment.platen_speed=1e-9 --set scene.end_time=0 --set scene.steps="$steps" --set output.hdf5=false >"$dir.log" 2>&1 ||
     { echo "run failed: $dir.log" >&2; exit 1; }
   r="$dir/results.json"
   spheres=$(json "$r" sphere_count)
