@@ -64,6 +64,7 @@ class ZwickExperiment final : public Experiment {
           1, static_cast<std::uint64_t>(std::llround(s_.sample_interval / world->dt())));
     if (world->stepCount() % sample_every_ != 0) return true;
     if (phase_ == Phase::Settle) {
+      collectBreaks(*world);  // a specimen may lose bonds while it settles
       if (s_.settle_first && !settle_.over(*world)) return true;
       startLoading(world, ctx);
       return true;
