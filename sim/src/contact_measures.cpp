@@ -2,11 +2,10 @@
 // stress of each ball (World::particleStress, dem-models.md §11) with its
 // principal values (particle_stress.h), and the load on each wall
 // (World::wallForces).
-#include "rocklab/sim/particle_stress.h"
-
 #include <Eigen/Eigenvalues>
 #include <numbers>
 
+#include "rocklab/sim/particle_stress.h"
 #include "world_impl.h"
 
 namespace rocklab::sim {
@@ -39,10 +38,25 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 
 }  // namespace
 
-template <class Law>
-std::vector<Vec3> World::Impl::wallLoads() const {
-  std::vector<Vec3> load(model.walls.size(), Vec3::Zero());
-  for (std::size_t i = 0; i < p.size(); ++i)
+/// Calls pair(i, j, point, force on i) for every touching ball pair and
+/// wall(i, wall, point, force on i) for every touching ball-wall contact, with
+/// the elastic contact force (normal spring at the overlap the law sees, and the
+/// shear spring; no dashpots) of the last step.
+template <class Law, class PairVisit, class WallVisit>
+void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
+      if (!history.pair_touch[k]) continue;
+      const std::uint32_t j = nb.pairs.partner[k];
+      ContactPoint touch;
+      if (!ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch)) continue;
+      const double overlap = pairOverlap(touch, k);
+      if (overlap <= 0) continue;
+      double secant, tangent;
+      Law::normal(pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), secant,
+                  tangent);
+      pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal));
+    }
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
       if (!history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
@@ -52,48 +66,37 @@ std::vector<Vec3> World::Impl::wallLoads() const {
       if (overlap <= 0) continue;
       double secant, tangent;
       Law::normal(wallProps(i, wk), overlap, p.radius[i], secant, tangent);
-      load[wk] -= history.wall_shear[c] - secant * overlap * touch.normal;  // minus the force on the ball
+      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal));
     }
+  }
+}
+
+template <class Law>
+std::vector<Vec3> World::Impl::wallLoads() const {
+  std::vector<Vec3> load(model.walls.size(), Vec3::Zero());
+  forEachElasticContact<Law>([](std::size_t, std::uint32_t, const Vec3&, const Vec3&) {},
+                             [&](std::size_t, std::uint32_t wk, const Vec3&, const Vec3& on_ball) {
+                               load[wk] -= on_ball;  // the wall feels minus the force on the ball
+                             });
   return load;
 }
 
 std::vector<Vec3> World::wallForces() const {
-  return impl_->model.contact.law == ContactLaw::Linear ? impl_->wallLoads<detail::LinearLaw>()
-                                                        : impl_->wallLoads<detail::HertzMindlinLaw>();
+  return impl_->model.contact.law == ContactLaw::Linear
+             ? impl_->wallLoads<detail::LinearLaw>()
+             : impl_->wallLoads<detail::HertzMindlinLaw>();
 }
 
 template <class Law>
 void World::Impl::contactStress(std::vector<Mat3>& sum) const {
-  const Impl& w = *this;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (std::uint32_t k = w.nb.pairs.row_offset[i]; k < w.nb.pairs.row_offset[i + 1]; ++k) {
-      if (!w.history.pair_touch[k]) continue;
-      const std::uint32_t j = w.nb.pairs.partner[k];
-      ContactPoint touch;
-      if (!ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch)) continue;
-      const double overlap = w.pairOverlap(touch, k);
-      if (overlap <= 0) continue;
-      double secant, tangent;
-      Law::normal(w.pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), secant,
-                  tangent);
-      const Vec3 on_i = w.history.pair_shear[k] - secant * overlap * touch.normal;
-      sum[i] += stressMoment(touch.point - p.position[i], on_i);
-      sum[j] += stressMoment(touch.point - p.position[j], -on_i);
-    }
-    for (std::uint32_t c = w.nb.wall_offset[i]; c < w.nb.wall_offset[i + 1]; ++c) {
-      if (!w.history.wall_touch[c]) continue;
-      const std::uint32_t wk = w.nb.wall_index[c];
-      ContactPoint touch;
-      if (!ballWallTouch(w.walls[wk], w.model.walls[wk], p.position[i], p.radius[i], touch))
-        continue;
-      const double overlap = w.wallOverlap(touch, c);
-      if (overlap <= 0) continue;
-      double secant, tangent;
-      Law::normal(w.wallProps(i, wk), overlap, p.radius[i], secant, tangent);
-      const Vec3 on_i = w.history.wall_shear[c] - secant * overlap * touch.normal;
-      sum[i] += stressMoment(touch.point - p.position[i], on_i);
-    }
-  }
+  forEachElasticContact<Law>(
+      [&](std::size_t i, std::uint32_t j, const Vec3& point, const Vec3& on_i) {
+        sum[i] += stressMoment(point - p.position[i], on_i);
+        sum[j] += stressMoment(point - p.position[j], -on_i);
+      },
+      [&](std::size_t i, std::uint32_t, const Vec3& point, const Vec3& on_i) {
+        sum[i] += stressMoment(point - p.position[i], on_i);
+      });
 }
 
 std::vector<Mat3> World::particleStress() const {
@@ -108,8 +111,8 @@ std::vector<Mat3> World::particleStress() const {
   for (std::size_t k = 0; k < b.size(); ++k) {
     if (!b.intact[k]) continue;
     const std::uint32_t i = b.a[k], j = b.b[k];
-    const double gap = (p.position[j] - p.position[i]).norm() - p.radius[i] - p.radius[j];
-    const Vec3 point = p.position[i] + b.normal[k] * (p.radius[i] + 0.5 * gap);
+    const Vec3 point = bondPoint(p.position[i], p.radius[i], p.radius[j], b.normal[k],
+                                 (p.position[j] - p.position[i]).norm());
     sum[j] += stressMoment(point - p.position[j], w.bonds.force_b[k]);
     sum[i] += stressMoment(point - p.position[i], -w.bonds.force_b[k]);
   }

@@ -92,6 +92,12 @@ struct ContactPoint {
   return true;
 }
 
+/// Where a bond between ball a (xa, ra) and ball b acts: the middle of the gap
+/// (or overlap) between their surfaces along n (unit, a -> b) at centre distance `dist`.
+inline Vec3 bondPoint(const Vec3& xa, double ra, double rb, const Vec3& n, double dist) {
+  return xa + n * (ra + 0.5 * (dist - ra - rb));
+}
+
 /// Effective radius of two balls (Eq 2-24).
 inline double effectiveRadius(double ri, double rj) { return 2.0 * ri * rj / (ri + rj); }
 
@@ -274,6 +280,8 @@ struct World::Impl {
   template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
   std::string stepAdvice() const;
   // On demand (contact_measures.cpp): World::particleStress, World::wallForces.
+  template <class Law, class PairVisit, class WallVisit>
+  void forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const;
   template <class Law> void contactStress(std::vector<geometry::Mat3>& sum) const;
   template <class Law> std::vector<Vec3> wallLoads() const;
   // 8. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)

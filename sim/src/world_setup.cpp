@@ -88,6 +88,16 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
 
 namespace {
 
+/// "" or why bond k cannot join balls a and b of a world of n balls.
+std::string bondEndsProblem(std::size_t k, std::uint32_t a, std::uint32_t b, std::size_t n) {
+  std::ostringstream e;
+  if (a >= n || b >= n)
+    e << "bond " << k << ": ball " << std::max(a, b) << " does not exist (the world has " << n << " balls)";
+  else if (a == b)
+    e << "bond " << k << ": joins ball " << a << " to itself";
+  return e.str();
+}
+
 /// "" or what is wrong with the bonds of a world of `p`'s balls.
 std::string validateBonds(const ParallelBondModel& bm, const ParticleState& p, const BondState& bonds) {
   if (bonds.size() == 0) return {};
@@ -107,14 +117,7 @@ std::string validateBonds(const ParallelBondModel& bm, const ParticleState& p, c
   const std::size_t n = p.size();
   for (std::size_t k = 0; k < bonds.size(); ++k) {
     const std::uint32_t a = bonds.a[k], b = bonds.b[k];
-    if (a >= n || b >= n) {
-      e << "bond " << k << ": ball " << std::max(a, b) << " does not exist (the world has " << n << " balls)";
-      return e.str();
-    }
-    if (a == b) {
-      e << "bond " << k << ": joins ball " << a << " to itself";
-      return e.str();
-    }
+    if (std::string bad = bondEndsProblem(k, a, b, n); !bad.empty()) return bad;
     if (!p.clump.empty() && p.clump[a] >= 0 && p.clump[a] == p.clump[b]) {
       e << "bond " << k << ": balls " << a << " and " << b << " are members of one rigid clump";
       return e.str();
@@ -199,13 +202,10 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vec
       w.placeMembers(c);
     }
   }
+  // The ends first: installing a bond reads its balls' radii.
   for (std::size_t k = 0; k < bond_specs.size(); ++k)
-    if (bond_specs[k].a >= n || bond_specs[k].b >= n) {
-      std::ostringstream e;
-      e << "bond " << k << ": ball " << std::max(bond_specs[k].a, bond_specs[k].b)
-        << " does not exist (the world has " << n << " balls)";
-      throw std::invalid_argument(e.str());
-    }
+    if (std::string bad = bondEndsProblem(k, bond_specs[k].a, bond_specs[k].b, n); !bad.empty())
+      throw std::invalid_argument(bad);
   w.installBonds(bond_specs);
   if (const std::string bad = validateBonds(w.model.bonds, p, w.bonds.state); !bad.empty())
     throw std::invalid_argument(bad);

@@ -114,6 +114,7 @@ class ZwickExperiment final : public Experiment {
       top.motion = {};
       top.motion.velocity = -s_.platen_speed * up_;
     });
+    seen_breaks_ = 0;  // the settling World's log (collected by advance) went with it
     phase_ = Phase::Load;
     total_volume_ = 0;
     for (double r : world->particles().radius)
@@ -145,12 +146,8 @@ class ZwickExperiment final : public Experiment {
     return x.travel < s_.start_gap + s_.max_strain * height_;
   }
 
-  /// Every breakage of this World not yet seen (a phase switch starts a new log).
+  /// Every breakage of this World not yet seen (each World has its own log).
   void collectBreaks(const sim::World& world) {
-    if (&world != last_world_) {
-      last_world_ = &world;
-      seen_breaks_ = 0;
-    }
     const auto& log = world.bondBreaks();
     for (; seen_breaks_ < log.size(); ++seen_breaks_) breaks_.push_back(log[seen_breaks_]);
   }
@@ -170,7 +167,6 @@ class ZwickExperiment final : public Experiment {
   ZwickSample peak_, failure_;
   bool failed_ = false;
   std::vector<sim::BondBreak> breaks_;
-  const sim::World* last_world_ = nullptr;
   std::size_t seen_breaks_ = 0;
   std::vector<double> final_fragments_;  // m^3, at the last sample, largest first
 };

@@ -95,9 +95,7 @@ void World::Impl::bondStage() {
     const double dist = d.norm();
     const Vec3 n_old = s.normal[k];
     const Vec3 n = dist > 0 ? Vec3(d / dist) : n_old;
-    // The bond acts at the middle of the gap (or overlap) between the surfaces.
-    const double gap = dist - p.radius[a] - p.radius[b];
-    const Vec3 xc = xa + n * (p.radius[a] + 0.5 * gap);
+    const Vec3 xc = bondPoint(xa, p.radius[a], p.radius[b], n, dist);
     // Stored shear force and bending moment turn with the contact plane: its
     // tilt (n_old -> n) and its spin about n, the mean of the balls' spins.
     const double spin = 0.5 * (p.omega[a] + p.omega[b]).dot(n) * h;
@@ -264,12 +262,12 @@ void World::Impl::bondSprings(std::vector<NetworkSpring>& out) const {
     const BondDisc d = bondDisc(s.radius[k]);
     const std::uint32_t a = s.a[k], b = s.b[k];
     const Vec3 n = s.normal[k];
-    const double gap = (p.position[b] - p.position[a]).norm() - p.radius[a] - p.radius[b];
     NetworkSpring spring;
     spring.a = a;
     spring.b = b;
     spring.normal = n;
-    spring.point = p.position[a] + n * (p.radius[a] + 0.5 * gap);
+    spring.point = bondPoint(p.position[a], p.radius[a], p.radius[b], n,
+                             (p.position[b] - p.position[a]).norm());
     spring.kn = model.bonds.normal_stiffness * d.area;
     spring.ks = model.bonds.shear_stiffness * d.area;
     out.push_back(spring);
