@@ -10,6 +10,7 @@
 #include "agglomerate/agglomerate_cli.h"
 #include "analysis/weibull_report.h"
 #include "camera/render_run.h"
+#include "rocklab/experiments/bond_calibration.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/shape.h"
@@ -39,6 +40,7 @@ Examples:
   parallel --jobs 2 < runs/dt/runs.txt && rocklab collect runs/dt
   rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
+  rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), 2 bad input
 (nothing written), 3 stopped by the stability
@@ -104,6 +106,10 @@ struct CliArgs {
   ShapeOptions shape_options;
   bool no_preview = false;
   AgglomerateOptions agglomerate_options;
+  // calibrate-bonds
+  std::string fraction;
+  double sigma0_mpa = 0, modulus = 0, trial_strength = 60e6;
+  int count = 30, trials = 3;
 };
 
 void addRunOptions(CLI::App* c, CliArgs& a) {
@@ -199,6 +205,22 @@ void addCommands(CLI::App& app, CliArgs& a) {
   weibull->add_option("--column", a.weibull_column, "sweep.csv column with the strengths in MPa")
       ->capture_default_str();
 
+  auto* bonds = app.add_subcommand(
+      "calibrate-bonds",
+      "Bond strength that reproduces a lab fraction's Weibull sigma0 and m (trials B0 = B sigma0/sigma, then a batch)");
+  bonds->add_option("scene", a.scene_arg, "Crushing scene (with [bonds]) file or built-in name")->required();
+  bonds->add_option("--fraction", a.fraction, "Table 5.1 fraction, mm: " + tableFiveOneNames());
+  bonds->add_option("--sigma0", a.sigma0_mpa, "Target 37 % strength, MPa (instead of --fraction)");
+  bonds->add_option("--modulus", a.modulus, "Target Weibull modulus m (instead of --fraction)");
+  bonds->add_option("--trial-strength", a.trial_strength, "Bond strength of the first trial, Pa")
+      ->capture_default_str();
+  bonds->add_option("--trials", a.trials, "Trials at most, each scaling B by sigma0 / sigma")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  bonds->add_option("--count", a.count, "Agglomerates in the batch")->capture_default_str()->check(CLI::Range(3, 100000));
+  addRunOptions(bonds, a);
+  addSetOptions(bonds, a);
+
   auto* shape = app.add_subcommand("shape", "Mesh (STL/PLY/OBJ) -> checked mass properties and a clump of spheres with its error");
   shape->add_option("mesh", a.shape_options.mesh, "Mesh file (with --generate: the mesh file to write, .stl/.ply/.obj)")->required();
   shape->add_option("--out", a.shape_options.out_dir, "Output directory (clump.txt, clump.toml, preview.png, results.json)")->required();
@@ -282,6 +304,35 @@ int sweepCommand(const CliArgs& a, bool calibrate) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
+}
+
+/// calibrate-bonds: the target from Table 5.1 (--fraction) or given (--sigma0, --modulus).
+int calibrateBondsCommand(const CliArgs& a) {
+  BondCalibrationOptions c;
+  c.runs.scene = a.scene_arg;
+  c.runs.overrides = a.overrides;
+  c.trial_strength_Pa = a.trial_strength;
+  c.max_trials = a.trials;
+  c.count = a.count;
+  try {
+    applySetOptions(a, c.runs);
+    if (!a.fraction.empty()) {
+      const auto f = tableFiveOneFraction(a.fraction);
+      if (!f)
+        throw std::invalid_argument("--fraction " + a.fraction + ": Table 5.1 has " + tableFiveOneNames());
+      c.target = *f;
+    } else {
+      c.target.name = "given";
+    }
+    if (a.sigma0_mpa > 0) c.target.sigma0_MPa = a.sigma0_mpa;
+    if (a.modulus > 0) c.target.modulus = a.modulus;
+    if (!(c.target.sigma0_MPa > 0 && c.target.modulus > 0))
+      throw std::invalid_argument("give --fraction (" + tableFiveOneNames() + ") or --sigma0 and --modulus");
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: calibrate-bonds: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return runBondCalibration(c, std::cerr);
 }
 
 /// run, demo, restart and check: one scene, loaded and checked, then run.
@@ -373,6 +424,7 @@ int runCli(int argc, const char* const* argv) {
   }
   if (app.got_subcommand("render")) return renderRun({a.run_file_arg, a.camera_file, a.out_dir}, std::cerr);
   if (app.got_subcommand("study")) return studyCommand(a);
+  if (app.got_subcommand("calibrate-bonds")) return calibrateBondsCommand(a);
   if (app.got_subcommand("sweep") || app.got_subcommand("calibrate"))
     return sweepCommand(a, app.got_subcommand("calibrate"));
 

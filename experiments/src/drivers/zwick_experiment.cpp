@@ -114,6 +114,9 @@ class ZwickExperiment final : public Experiment {
       top.motion = {};
       top.motion.velocity = -s_.platen_speed * up_;
     });
+    if (s_.sample_travel > 0)
+      sample_every_ = std::max<std::uint64_t>(
+          1, static_cast<std::uint64_t>(std::llround(s_.sample_travel / s_.platen_speed / world->dt())));
     seen_breaks_ = 0;  // the settling World's log (collected by advance) went with it
     phase_ = Phase::Load;
     total_volume_ = 0;
@@ -282,6 +285,7 @@ std::shared_ptr<ExperimentSettings> readZwickSettings(TableReader& t,
   e->settle_first = t.boolean("settle_first", e->settle_first);
   readSettleSettings(t, e->settle);
   e->start_gap = t.number("start_gap", e->start_gap, Range::nonNegative());
+  e->sample_travel = t.number("sample_travel", e->sample_travel, Range::nonNegative());
   e->max_strain = t.number("max_strain", e->max_strain, {0.0, 1.0, true, false});
   e->failure_volume_fraction =
       t.number("failure_volume_fraction", e->failure_volume_fraction, {0.0, 1.0, true, false});

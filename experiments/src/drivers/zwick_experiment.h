@@ -17,6 +17,9 @@ struct ZwickSettings final : ExperimentSettings {
   bool settle_first = false;  // let the specimen settle on the bottom platen under gravity first
   SettleSettings settle;
   double start_gap = 2e-4;  // m between the top platen and the specimen when loading starts
+  // m of platen travel between samples while loading (0: every sample_interval s). By
+  // travel, a platen-speed study samples every speed at the same points of the curve.
+  double sample_travel = 0.0;
   double max_strain =
       0.3;  // -  loading ends when the platens closed by this fraction of the specimen
   // §e failure rule: failed once the pieces broken off the largest fragment exceed this

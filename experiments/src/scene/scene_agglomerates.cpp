@@ -2,10 +2,15 @@
 // one body (experiments.md §f): the hexagonal close packing of the anisotropy
 // study (§f.3), every touching pair bonded, or one agglomerate of a library
 // written by `rocklab agglomerate` (dense random packing §f.4, carved from a
-// scan §f.7, or HCP), with its bonds.
+// scan §f.7, or HCP), with its bonds, or a dense random packing made here
+// (§f.4: the same generator as `rocklab agglomerate --method dense`).
+#include <map>
+#include <mutex>
 #include <numbers>
+#include <sstream>
 
 #include "agglomerate/agglomerate_library.h"
+#include "agglomerate/agglomerate_methods.h"
 #include "rocklab/geometry/bond_pairs.h"
 #include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/hcp_packing.h"
@@ -75,17 +80,64 @@ void readLibrary(TableReader& t, const std::filesystem::path& base_dir, Agglomer
   report.coordination_number = a.coordination_number;
 }
 
+/// A dense random packing (§f.4) made at load time: the servo-compacted loose pack
+/// of r_max spheres filling the diameter, its voids filled down to r_max / r0.
+/// Its own seed (not the scene's), so a study can turn one agglomerate through
+/// random orientations (scene.seed) or draw new ones (seed).
+void readDense(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sphere>& body,
+               std::vector<geometry::SpherePair>& pairs) {
+  agglomerate::AgglomerateSpec spec;
+  spec.method = agglomerate::Method::Dense;
+  spec.r_max = t.requiredNumber("radius", Range::positive());
+  spec.diameter = t.requiredNumber("diameter", Range::positive());
+  if (spec.diameter < 4 * spec.r_max) t.fail("diameter", "must be at least four sphere radii (radius = r_max)");
+  spec.r0 = t.number("r0", 4.0, Range::closed(1, 20));
+  spec.gap_tolerance = t.number("gap_tolerance", 1e-3, Range::closed(0, 0.5));
+  spec.seed = static_cast<std::uint64_t>(t.integer("seed", 1, Range::closed(0, 1e15)));
+  spec.pack.kind = agglomerate::parsePackKind(t.string("pack", "servo", {"servo", "geometric"}));
+  const double solid = std::pow(spec.diameter / spec.r_max, 3) / 8.0;  // r_max spheres in the diameter
+  if (solid * std::pow(spec.r0, 3) > 4e6)
+    t.fail("r0", "gives more than about 2e6 spheres for this diameter and radius");
+  // A sweep or study loads the scene once per variant to check it before any run:
+  // the same spec gives the same agglomerate, so make it once per process.
+  static std::mutex memo_mutex;
+  static std::map<std::string, agglomerate::GeneratedAgglomerate> memo;
+  std::ostringstream key;
+  key << std::hexfloat << spec.r_max << ' ' << spec.diameter << ' ' << spec.r0 << ' ' << spec.gap_tolerance
+      << ' ' << spec.seed << ' ' << static_cast<int>(spec.pack.kind);
+  agglomerate::GeneratedAgglomerate made;
+  {
+    std::lock_guard<std::mutex> lock(memo_mutex);
+    auto it = memo.find(key.str());
+    if (it == memo.end()) {
+      try {
+        it = memo.emplace(key.str(), agglomerate::generateAgglomerate(spec)).first;
+      } catch (const std::exception& e) {
+        t.fail("diameter", std::string("no dense agglomerate: ") + e.what());
+      }
+    }
+    made = it->second;
+  }
+  body = std::move(made.spheres);
+  pairs = std::move(made.bonds);
+  report.diameter = made.diameter;
+  report.porosity = made.structure.porosity;
+  report.coordination_number = made.structure.coordination_number;
+}
+
 }  // namespace
 
 void readAgglomerate(TableReader& t, int material, const std::filesystem::path& base_dir,
                      geometry::Rng& rng, Scene& scene) {
   AgglomerateReport report;
   report.source = t.path();
-  report.method = t.string("method", "hcp", {"hcp", "library"});
+  report.method = t.string("method", "hcp", {"hcp", "dense", "library"});
   std::vector<geometry::Sphere> body;
   std::vector<geometry::SpherePair> pairs;
   if (report.method == "hcp")
     readHcp(t, report, body, pairs);
+  else if (report.method == "dense")
+    readDense(t, report, body, pairs);
   else
     readLibrary(t, base_dir, report, body, pairs);
   // The agglomerate's frame -> world: a fixed rotation (deg about x, y, z),

@@ -57,7 +57,7 @@ struct ClumpShapeReport {
 /// scene.bonds[first_bond, first_bond + bonds).
 struct AgglomerateReport {
   std::string source;           // particles.N
-  std::string method;           // "hcp" or "library"
+  std::string method;           // "hcp", "dense" or "library:<its method>"
   std::size_t first_ball = 0, balls = 0, first_bond = 0, bonds = 0;
   double diameter = 0;          // m, of the bounding sphere
   double porosity = 0;          // -, against the bounding sphere
