@@ -1,4 +1,6 @@
 // The Weibull analysis of crushing batches (experiments.md §e, Eq 5-2..5-5).
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -7,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analysis/strength_groups.h"
 #include "analysis/weibull.h"
 #include "analysis/weibull_report.h"
 
@@ -104,5 +107,53 @@ TEST_CASE("weibull: the batch command fits a sweep's strength column and refuses
   CHECK(experiments::weibullCommand(dir, "peak_force_N", bad) == 2);
   CHECK_THAT(bad.str(), Catch::Contains("no column 'peak_force_N'"));
   CHECK(experiments::weibullCommand(dir / "missing", "strength_MPa", bad) == 2);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("weibull: strength statistics per group and the size effect over the groups", "[weibull]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rocklab-strength-groups-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // Three sizes, four runs each: strengths 480.03 d^-1.1 (Eq 5-5) times 0.8, 0.9, 1.1, 1.2.
+  const double sizes_mm[] = {20.0, 30.0, 40.0};
+  {
+    std::ofstream csv(dir / "sweep.csv");
+    csv << "particles.0.diameter,scene.seed,strength_MPa,zwick.platen_gap_at_peak_m,porosity,status\n";
+    for (double d : sizes_mm)
+      for (int k = 0; k < 4; ++k) {
+        const double f[] = {0.8, 0.9, 1.1, 1.2};
+        csv << d * 1e-3 << ',' << k + 1 << ',' << 480.03 * std::pow(d, -1.1) * f[k] << ',' << d * 1e-3 << ','
+            << 0.3 + 0.01 * k << ",ok\n";
+      }
+    csv << "0.05,1,,,,exit 3\n";  // a failed run: no group of its own
+  }
+  std::ostringstream log;
+  REQUIRE(experiments::strengthGroupsCommand(
+              dir, {"strength_MPa", "particles.0.diameter", "zwick.platen_gap_at_peak_m"}, log) == 0);
+  INFO(log.str());
+  std::ifstream in(dir / "strength_groups.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  REQUIRE(j["groups"].size() == 3);
+  for (std::size_t g = 0; g < 3; ++g) {
+    const nlohmann::json& row = j["groups"][g];
+    const double base = 480.03 * std::pow(sizes_mm[g], -1.1);
+    CHECK(row["runs"].get<int>() == 4);
+    CHECK(row["mean_MPa"].get<double>() == Approx(base));
+    // sd of {0.8, 0.9, 1.1, 1.2} (n - 1): sqrt(0.1 / 3).
+    CHECK(row["stddev_MPa"].get<double>() == Approx(base * std::sqrt(0.1 / 3)));
+    CHECK(row["cov"].get<double>() == Approx(std::sqrt(0.1 / 3)));
+    CHECK(row["weibull_m"].get<double>() > 0);
+    CHECK(row["mean"]["porosity"].get<double>() == Approx(0.315));
+  }
+  // The group means lie on Eq 5-5 exactly: the fit gives back a and b (d in mm).
+  CHECK(j["size_effect"]["a"].get<double>() == Approx(480.03));
+  CHECK(j["size_effect"]["b"].get<double>() == Approx(-1.1));
+  CHECK(j["size_effect"]["size_unit"].get<std::string>() == "mm");
+  CHECK(fs::exists(dir / "strength_groups.png"));
+  CHECK(fs::exists(dir / "strength_groups.csv"));
+  std::ostringstream bad;
+  CHECK(experiments::strengthGroupsCommand(dir, {"strength_MPa", "particles.0.r0", ""}, bad) == 2);
+  CHECK_THAT(bad.str(), Catch::Contains("no column 'particles.0.r0'"));
   fs::remove_all(dir);
 }

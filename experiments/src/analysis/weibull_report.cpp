@@ -7,60 +7,31 @@
 #include <sstream>
 
 #include "analysis/plot.h"
+#include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
 #include "common/atomic_file.h"
 #include "rocklab/experiments/run.h"  // exit codes
 
 namespace rocklab::experiments {
 
-namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, ',')) cells.push_back(cell);
-  return cells;
-}
-
-}  // namespace
-
 int weibullCommand(const std::filesystem::path& dir, const std::string& column, std::ostream& log) {
   const std::filesystem::path csv = dir / "sweep.csv";
-  std::ifstream in(csv);
-  if (!in) {
-    log << "error: " << csv.string()
-        << ": cannot read (run a sweep over the batch first, e.g. --vary scene.seed=1,2,...)\n";
-    return kExitBadInput;
-  }
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = splitCsv(line);
-  std::size_t col = header.size(), status = header.size();
-  for (std::size_t k = 0; k < header.size(); ++k) {
-    if (header[k] == column) col = k;
-    if (header[k] == "status") status = k;
-  }
-  if (col == header.size()) {
-    log << "error: " << csv.string() << ": no column '" << column << "' (columns: " << line
-        << "); sweep with --metric " << column << "\n";
-    return kExitBadInput;
-  }
   std::vector<double> strengths;
   std::size_t skipped = 0;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> cells = splitCsv(line);
-    double v = NAN;
-    if (col < cells.size() && (status >= cells.size() || cells[status] == "ok")) {
-      try {
-        v = std::stod(cells[col]);
-      } catch (const std::exception&) {
-      }
+  try {
+    const SweepTable table = readSweepTable(dir);
+    const std::size_t col = table.column(column);
+    skipped = table.not_ok;
+    for (const auto& row : table.rows) {
+      const auto v = SweepTable::numberIn(row, col);
+      if (v && *v > 0)
+        strengths.push_back(*v);
+      else
+        ++skipped;
     }
-    if (std::isfinite(v) && v > 0)
-      strengths.push_back(v);
-    else
-      ++skipped;
+  } catch (const std::invalid_argument& e) {
+    log << "error: " << e.what() << "\n";
+    return kExitBadInput;
   }
   WeibullFit fit;
   try {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "agglomerate/agglomerate_cli.h"
+#include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
 #include "camera/render_run.h"
 #include "rocklab/experiments/bond_calibration.h"
@@ -92,7 +93,7 @@ namespace {
 /// Everything the command line can set: CLI11 fills it, the commands read it.
 struct CliArgs {
   std::string scene_arg, checkpoint_arg, run_file_arg, out_dir, camera_file, collect_dir;
-  std::string weibull_column = "strength_MPa";
+  std::string weibull_column = "strength_MPa", group_by, size_column;
   std::vector<std::string> overrides;
   int threads = 0;
   bool quiet = false, skip_complete = false;
@@ -204,6 +205,12 @@ void addCommands(CLI::App& app, CliArgs& a) {
   weibull->add_option("dir", a.collect_dir, "Folder of the batch's sweep (holds sweep.csv)")->required();
   weibull->add_option("--column", a.weibull_column, "sweep.csv column with the strengths in MPa")
       ->capture_default_str();
+  weibull->add_option("--group-by", a.group_by,
+                      "Statistics per value of this column (a varied key, e.g. particles.0.r0): "
+                      "strength_groups.csv/.json/.png");
+  weibull->add_option("--size-column", a.size_column,
+                      "With --group-by: fit the size effect sigma_av = a d^b (Eq 5-5) with d = this column's "
+                      "mean per group (a column ending in _m is fitted in mm)");
 
   auto* bonds = app.add_subcommand(
       "calibrate-bonds",
@@ -413,7 +420,16 @@ int runCli(int argc, const char* const* argv) {
 
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
-  if (app.got_subcommand("weibull")) return weibullCommand(a.collect_dir, a.weibull_column, std::cerr);
+  if (app.got_subcommand("weibull")) {
+    if (a.group_by.empty()) {
+      if (!a.size_column.empty()) {
+        std::cerr << "error: weibull: --size-column needs --group-by (the sizes are fitted over the groups)\n";
+        return kExitBadInput;
+      }
+      return weibullCommand(a.collect_dir, a.weibull_column, std::cerr);
+    }
+    return strengthGroupsCommand(a.collect_dir, {a.weibull_column, a.group_by, a.size_column}, std::cerr);
+  }
   if (app.got_subcommand("shape")) {
     a.shape_options.preview = !a.no_preview;
     return runShape(a.shape_options, std::cerr);

@@ -32,6 +32,9 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   if (type == "drop") m = {"restitution", "drop.contact_time_s"};
   if (type == "heap") m = {"angle_of_repose_deg", "heap.settled"};
   if (type == "chute") m = {"clearance_time_s", "jammed", "chute.bodies"};
+  if (type == "zwick")
+    m = {"strength_MPa", "peak_force_N", "zwick.platen_gap_at_peak_m", "bonds_broken", "sphere_count",
+         "bond_count", "porosity", "coordination_number"};
   m.push_back("simulated_time_s");
   m.push_back("wall_time_s.total");
   return m;
