@@ -85,9 +85,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
 
       // --- [watchdog]
       {"watchdog", "", "", "Stops a run that blows up, naming the particle, the time and the setting to change (exit code 3)."},
-      {"watchdog", "max_overlap_fraction", "", "Overlap, as a fraction of the smaller radius, that stops the run."},
+      {"watchdog", "max_overlap_fraction", "", "Overlap, as a fraction of the smaller radius, that stops the run (checked every step)."},
       {"watchdog", "max_energy_growth", "", "Allowed rise of mechanical energy beyond the work of moving walls, fraction of its scale."},
-      {"watchdog", "check_interval", "", "Steps between the energy and overlap checks."},
+      {"watchdog", "check_interval", "", "Steps between energy checks (the overlap is checked every step, the energy also at every observed step)."},
       {"watchdog", "network_iterations", "", "Power iterations of the contact-network step check; 0 = off."},
       {"watchdog", "network_interval", "", "Steps between contact-network step checks."},
 
