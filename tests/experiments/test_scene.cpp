@@ -7,6 +7,8 @@
 #include "drivers/chute_experiment.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/sweep.h"
+#include "scene/scene_keys.h"
+#include "scene/toml_reader.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
@@ -280,4 +282,49 @@ TEST_CASE("watchdog network keys and relaxation.steps are read and range-checked
   CHECK(d.model.watchdog.network_iterations > 0);
   CHECK_THAT(errorOf(kMinimal, {"relaxation.steps=-1"}), Contains("relaxation.steps"));
   CHECK_THAT(errorOf(kMinimal, {"watchdog.network_interval=0"}), Contains("network_interval"));
+}
+
+TEST_CASE("the readers record every key they read, for the scene reference", "[scene]") {
+  using rocklab::experiments::detail::KeyRead;
+  namespace d = rocklab::experiments::detail;
+  d::recordSceneKeys(true);
+  loadSceneText(kMinimal + "\n[[walls]]\ntype = \"plane\"\nmaterial = \"rock\"\npoint = [0, 0, 0]\n"
+                           "normal = [0, 0, 1]\n[walls.motion]\nvelocity = [0, 0, 1]\n",
+                "keys.toml");
+  const std::vector<KeyRead> reads = d::recordedSceneKeys();
+  d::recordSceneKeys(false);
+  auto find = [&](const std::string& table, const std::string& key) -> const KeyRead* {
+    for (const KeyRead& r : reads)
+      if (r.table == table && r.key == key && !r.kind.empty()) return &r;
+    return nullptr;
+  };
+  // A named entry's table is documented as NAME; its defaults are the reader's own.
+  const KeyRead* density = find("materials.NAME", "density");
+  REQUIRE(density);
+  CHECK(density->kind == "number");
+  CHECK(density->allowed == "> 0");
+  CHECK(density->fallback == "2730");
+  CHECK_FALSE(density->required);
+  // Array entries drop their index; required keys have no default.
+  const KeyRead* name = find("scene", "name");
+  REQUIRE(name);
+  CHECK(name->required);
+  const KeyRead* law = find("contact", "law");
+  CHECK_FALSE(law);  // no [contact] table in the scene: its keys are not read
+  const KeyRead* point = find("walls", "point");
+  REQUIRE(point);
+  CHECK(point->kind == "[x, y, z]");
+  REQUIRE(find("walls.motion", "velocity"));
+  REQUIRE(find("particles", "positions"));
+  // Nothing is recorded while recording is off.
+  loadSceneText(kMinimal, "again.toml");
+  CHECK(d::recordedSceneKeys().size() == reads.size());
+}
+
+TEST_CASE("every documented scene key names its table and says what it does", "[scene]") {
+  for (const KeyDoc& k : sceneKeyDocs()) {
+    INFO(std::string(k.table) + " " + k.key);
+    CHECK(std::string(k.text).size() > 5);
+    CHECK(std::string(k.text).find('|') == std::string::npos);  // a Markdown table cell
+  }
 }

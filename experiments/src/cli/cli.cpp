@@ -6,6 +6,7 @@
 #include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "agglomerate/agglomerate_cli.h"
 #include "analysis/strength_groups.h"
@@ -19,6 +20,7 @@
 #include "rocklab/experiments/sweep.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/world.h"
+#include "scene/scene_keys.h"
 
 namespace rocklab::experiments {
 
@@ -42,6 +44,7 @@ Examples:
   rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
+  rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), 2 bad input
 (nothing written), 3 stopped by the stability
@@ -77,6 +80,28 @@ void listFiles(const std::string& title, const std::filesystem::path& dir,
     std::cout << "  " << name << std::string(name.size() < 20 ? 22 - name.size() : 2, ' ')
               << firstLine(description) << "\n";
   }
+}
+
+/// rocklab scene-keys: the scene reference as Markdown on stdout; with `check`,
+/// compares it with that file instead (ctest "scene-keys").
+int doSceneKeys(const std::string& check) {
+  std::vector<std::string> problems;
+  const std::string markdown = sceneKeysMarkdown(problems);
+  for (const std::string& p : problems) std::cerr << "scene-keys: " << p << "\n";
+  if (check.empty()) {
+    std::cout << markdown;
+    return problems.empty() ? kExitOk : kExitFailed;
+  }
+  std::ifstream in(check);
+  std::stringstream committed;
+  committed << in.rdbuf();
+  if (!in || committed.str() != markdown) {
+    std::cerr << "scene-keys: " << check
+              << " is not the output of `rocklab scene-keys`; regenerate it: rocklab scene-keys > " << check
+              << "\n";
+    return kExitFailed;
+  }
+  return problems.empty() ? kExitOk : kExitFailed;
 }
 
 int doList() {
@@ -168,6 +193,8 @@ void addCommands(CLI::App& app, CliArgs& a) {
   check->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", a.overrides, "Override a scene key")->take_all();
   app.add_subcommand("list", "List the built-in scenes and studies");
+  auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
+  keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
   render->add_option("run", a.run_file_arg, "run.h5 written by an earlier run")->required();
   render->add_option("--camera", a.camera_file, "TOML file with [[cameras]] tables (default: the scene's cameras)");
@@ -419,6 +446,7 @@ int runCli(int argc, const char* const* argv) {
   }
 
   if (app.got_subcommand("list")) return doList();
+  if (app.got_subcommand("scene-keys")) return doSceneKeys(a.collect_dir);
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("weibull")) {
     if (a.group_by.empty()) {

@@ -19,7 +19,8 @@ void readExperiment(TableReader& root, Scene& scene) {
   const double sample_interval =
       t->number("sample_interval", ExperimentSettings{}.sample_interval, Range::positive());
   // The driver reads and checks the keys of its type into its settings
-  // (drivers/registry.cpp).
+  // (drivers/registry.cpp); they are documented as [experiment] type = "TYPE".
+  t->setDocTable("experiment." + scene.experiment_type);
   auto settings = findExperimentDriver(scene.experiment_type)
                       ->read_settings(*t, SettingsContext{scene.model, scene.cameras});
   settings->sample_interval = sample_interval;

@@ -1,6 +1,7 @@
 #include "scene/toml_reader.h"
 
 #include <charconv>
+#include <mutex>
 #include <sstream>
 
 namespace rocklab::experiments::detail {
@@ -40,7 +41,60 @@ bool toVec3(const toml::node& n, geometry::Vec3& out) {
     if (!toNumber(*a->get(static_cast<std::size_t>(k)), out[k])) return false;
   return true;
 }
+/// The shortest text that reads back as `v` ("0.3", "2650", "1e-06", "inf").
+std::string numberText(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buffer[64];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+  return std::string(buffer, end);
+}
+std::string vecText(const geometry::Vec3& v) {
+  return "[" + numberText(v.x()) + ", " + numberText(v.y()) + ", " + numberText(v.z()) + "]";
+}
+std::string quotedList(const std::vector<std::string>& allowed) {
+  std::string options;
+  for (const auto& a : allowed) options += (options.empty() ? "" : ", ") + ("\"" + a + "\"");
+  return options;
+}
+
+/// The keys read while recording (rocklab scene-keys).
+struct KeyRegistry {
+  std::mutex mutex;
+  bool on = false;
+  std::set<KeyRead> reads;
+};
+KeyRegistry& keyRegistry() {
+  static KeyRegistry registry;
+  return registry;
+}
+/// While alive, the reads of `reader` are recorded as required.
+struct RequiredRead {
+  bool& flag;
+  explicit RequiredRead(bool& f) : flag(f) { flag = true; }
+  ~RequiredRead() { flag = false; }
+};
 }  // namespace
+
+void recordSceneKeys(bool on) {
+  KeyRegistry& r = keyRegistry();
+  std::lock_guard lock(r.mutex);
+  r.on = on;
+  if (on) r.reads.clear();
+}
+
+std::vector<KeyRead> recordedSceneKeys() {
+  KeyRegistry& r = keyRegistry();
+  std::lock_guard lock(r.mutex);
+  return {r.reads.begin(), r.reads.end()};
+}
+
+void TableReader::note(const std::string& key, const std::string& kind, const std::string& allowed,
+                       const std::string& fallback) const {
+  KeyRegistry& r = keyRegistry();
+  std::lock_guard lock(r.mutex);
+  if (!r.on) return;
+  r.reads.insert({doc_table_, key, kind, allowed, required_read_ ? std::string() : fallback, required_read_});
+}
 
 std::string Range::describe() const {
   std::ostringstream s;
@@ -68,7 +122,14 @@ std::string where(const toml::source_region& src) {
 
 TableReader::TableReader(const toml::table& table, std::string path,
                          std::shared_ptr<const Overrides> overrides)
-    : table_(&table), path_(std::move(path)), overrides_(std::move(overrides)) {}
+    : table_(&table), path_(std::move(path)), overrides_(std::move(overrides)) {
+  // The documentation table: the dotted path without array indices.
+  std::stringstream parts(path_);
+  std::string part;
+  while (std::getline(parts, part, '.'))
+    if (part.find_first_not_of("0123456789") != std::string::npos)
+      doc_table_ += (doc_table_.empty() ? "" : ".") + part;
+}
 
 std::string TableReader::keyPath(const std::string& key) const {
   return path_.empty() ? key : path_ + "." + key;
@@ -89,7 +150,10 @@ void TableReader::fail(const std::string& key, const std::string& what) const {
   throw SceneError(s.str());
 }
 
-bool TableReader::has(const std::string& key) const { return table_->contains(key); }
+bool TableReader::has(const std::string& key) const {
+  note(key, "", "", "");  // asked about; its kind comes from the read that follows
+  return table_->contains(key);
+}
 
 const toml::node* TableReader::node(const std::string& key) {
   used_.insert(key);
@@ -97,6 +161,7 @@ const toml::node* TableReader::node(const std::string& key) {
 }
 
 double TableReader::number(const std::string& key, double fallback, Range range) {
+  note(key, "number", range.describe(), numberText(fallback));
   const toml::node* n = node(key);
   if (!n) return fallback;
   double v;
@@ -108,11 +173,14 @@ double TableReader::number(const std::string& key, double fallback, Range range)
 }
 
 double TableReader::requiredNumber(const std::string& key, Range range) {
+  const RequiredRead required(required_read_);
+  note(key, "number", range.describe(), "");
   if (!has(key)) fail(key, "missing; a number " + range.describe() + " is required");
   return number(key, 0.0, range);
 }
 
 std::int64_t TableReader::integer(const std::string& key, std::int64_t fallback, Range range) {
+  note(key, "integer", range.describe(), std::to_string(fallback));
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto i = n->as_integer();
@@ -123,6 +191,7 @@ std::int64_t TableReader::integer(const std::string& key, std::int64_t fallback,
 }
 
 bool TableReader::boolean(const std::string& key, bool fallback) {
+  note(key, "boolean", "true, false", fallback ? "true" : "false");
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto b = n->as_boolean();
@@ -132,6 +201,7 @@ bool TableReader::boolean(const std::string& key, bool fallback) {
 
 std::string TableReader::string(const std::string& key, const std::string& fallback,
                                 const std::vector<std::string>& allowed) {
+  note(key, "string", quotedList(allowed), "\"" + fallback + "\"");
   const toml::node* n = node(key);
   if (!n) return fallback;
   auto s = n->as_string();
@@ -144,6 +214,8 @@ std::string TableReader::string(const std::string& key, const std::string& fallb
 }
 
 std::string TableReader::requiredString(const std::string& key, const std::vector<std::string>& allowed) {
+  const RequiredRead required(required_read_);
+  note(key, "string", quotedList(allowed), "");
   if (!has(key)) {
     std::string options;
     for (const auto& a : allowed) options += (options.empty() ? "" : ", ") + ("\"" + a + "\"");
@@ -153,6 +225,7 @@ std::string TableReader::requiredString(const std::string& key, const std::vecto
 }
 
 geometry::Vec3 TableReader::vec3(const std::string& key, const geometry::Vec3& fallback) {
+  note(key, "[x, y, z]", "", vecText(fallback));
   const toml::node* n = node(key);
   if (!n) return fallback;
   geometry::Vec3 v;
@@ -161,11 +234,14 @@ geometry::Vec3 TableReader::vec3(const std::string& key, const geometry::Vec3& f
 }
 
 geometry::Vec3 TableReader::requiredVec3(const std::string& key) {
+  const RequiredRead required(required_read_);
+  note(key, "[x, y, z]", "", "");
   if (!has(key)) fail(key, "missing; an array of 3 numbers [x, y, z] is required");
   return vec3(key, geometry::Vec3::Zero());
 }
 
 std::vector<geometry::Vec3> TableReader::vec3List(const std::string& key) {
+  note(key, "array of [x, y, z]", "", "[]");
   const toml::node* n = node(key);
   std::vector<geometry::Vec3> out;
   if (!n) return out;
@@ -180,6 +256,7 @@ std::vector<geometry::Vec3> TableReader::vec3List(const std::string& key) {
 }
 
 std::vector<double> TableReader::numberList(const std::string& key, Range range) {
+  note(key, "array of numbers", range.describe(), "[]");
   const toml::node* n = node(key);
   std::vector<double> out;
   if (!n) return out;
@@ -195,6 +272,7 @@ std::vector<double> TableReader::numberList(const std::string& key, Range range)
 }
 
 std::vector<std::string> TableReader::valueTextList(const std::string& key) {
+  note(key, "array of values", "", "[]");
   const toml::node* n = node(key);
   std::vector<std::string> out;
   if (!n) return out;
@@ -216,6 +294,7 @@ std::vector<std::string> TableReader::valueTextList(const std::string& key) {
 }
 
 std::vector<std::string> TableReader::stringList(const std::string& key, const std::vector<std::string>& allowed) {
+  note(key, "array of strings", quotedList(allowed), "[]");
   const toml::node* n = node(key);
   std::vector<std::string> out;
   if (!n) return out;
@@ -234,25 +313,32 @@ std::vector<std::string> TableReader::stringList(const std::string& key, const s
 }
 
 std::optional<TableReader> TableReader::table(const std::string& key) {
+  note(named_entries_ ? "NAME" : key, "table", "", "");
   const toml::node* n = node(key);
   if (!n) return std::nullopt;
   auto t = n->as_table();
   if (!t) fail(key, "expected a table ([" + keyPath(key) + "]), got " + typeName(*n));
-  return TableReader(*t, keyPath(key), overrides_);
+  TableReader child(*t, keyPath(key), overrides_);
+  child.doc_table_ = (doc_table_.empty() ? "" : doc_table_ + ".") + (named_entries_ ? "NAME" : key);
+  return child;
 }
 
 std::vector<TableReader> TableReader::tableArray(const std::string& key) {
+  note(key, "array of tables", "", "");
   const toml::node* n = node(key);
   std::vector<TableReader> out;
   if (!n) return out;
   auto a = n->as_array();
   if (!a || !a->is_array_of_tables()) fail(key, "expected an array of tables ([[" + keyPath(key) + "]])");
-  for (std::size_t k = 0; k < a->size(); ++k)
+  for (std::size_t k = 0; k < a->size(); ++k) {
     out.emplace_back(*a->get(k)->as_table(), keyPath(key) + "." + std::to_string(k), overrides_);
+    out.back().doc_table_ = (doc_table_.empty() ? "" : doc_table_ + ".") + key;
+  }
   return out;
 }
 
 std::vector<std::string> TableReader::keys() const {
+  named_entries_ = true;
   std::vector<std::string> out;
   for (const auto& [k, v] : *table_) out.emplace_back(k.str());
   return out;

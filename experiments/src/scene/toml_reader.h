@@ -30,6 +30,20 @@ struct Range {
   std::string describe() const;
 };
 
+/// One key as a reader asked for it (rocklab scene-keys): the documentation
+/// table it belongs to ("materials.NAME", "walls", "experiment.chute"), its name,
+/// what kind of value it takes, the values allowed, its default as TOML text and
+/// whether it is required. Recorded only while recordSceneKeys(true).
+struct KeyRead {
+  std::string table, key, kind, allowed, fallback;
+  bool required = false;
+  auto operator<=>(const KeyRead&) const = default;
+};
+/// Starts (clearing what was recorded) or stops recording every key read.
+void recordSceneKeys(bool on);
+/// Every distinct key read since recording started.
+std::vector<KeyRead> recordedSceneKeys();
+
 class TableReader {
  public:
   /// Dotted key -> the --set assignment that gave it (messages then name the override).
@@ -67,9 +81,22 @@ class TableReader {
   /// Dotted key of this table, e.g. "walls.2".
   const std::string& path() const { return path_; }
   const toml::table& raw() const { return *table_; }
+  /// The documentation table of the keys read from now on (default: the dotted
+  /// path with array indices dropped, e.g. "walls"); the experiment reader sets
+  /// "experiment.TYPE" before the driver reads its keys.
+  void setDocTable(std::string table) { doc_table_ = std::move(table); }
+  const std::string& docTable() const { return doc_table_; }
 
  private:
   const toml::node* node(const std::string& key);
+  /// Records a key read (when recording) under doc_table_.
+  void note(const std::string& key, const std::string& kind, const std::string& allowed,
+            const std::string& fallback) const;
+  /// Set while a required...() read runs: its key is recorded as required.
+  bool required_read_ = false;
+  /// keys() was asked: the sub-tables are named entries (doc table "TABLE.NAME").
+  mutable bool named_entries_ = false;
+  std::string doc_table_;
   const toml::table* table_;
   std::string path_;
   std::set<std::string> used_;

@@ -1,0 +1,687 @@
+// The scene reference: one documentation line per key (adding a key to a
+// reader = adding its line here, in the table's group), the coverage scenes
+// that reach every reader branch, and the Markdown of docs/scene-format.md.
+#include "scene/scene_keys.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+#include "agglomerate/agglomerate_library.h"
+#include "rocklab/experiments/scene.h"
+#include "scene/toml_reader.h"
+
+namespace rocklab::experiments {
+
+const std::vector<KeyDoc>& sceneKeyDocs() {
+  // {table, key, unit, text, values (optional), default (optional)}; key "" = the table.
+  static const std::vector<KeyDoc> docs = {
+      // --- top level
+      {"", "scene", "", "[scene]: what the run is called and when it ends (required)."},
+      {"", "materials", "", "[materials.NAME]: the materials balls and walls refer to (at least one)."},
+      {"", "contact", "", "[contact]: the contact law and its damping."},
+      {"", "gravity", "", "[gravity]: gravity and its changes in time."},
+      {"", "timestep", "", "[timestep]: how the time step is chosen."},
+      {"", "neighbours", "", "[neighbours]: the neighbour search."},
+      {"", "watchdog", "", "[watchdog]: the stability checks that stop a run."},
+      {"", "relaxation", "", "[relaxation]: easing apart the overlaps a scene starts with."},
+      {"", "walls", "", "[[walls]]: the walls, one table each."},
+      {"", "particles", "", "[[particles]]: the particle sources, one table each."},
+      {"", "bonds", "", "[bonds]: the parallel bonds of the agglomerates (required with agglomerates)."},
+      {"", "cameras", "", "[[cameras]]: virtual cameras that film the run."},
+      {"", "experiment", "", "[experiment]: the laboratory procedure that drives the run; none = a plain run."},
+      {"", "output", "", "[output]: what the run writes."},
+
+      // --- [scene]
+      {"scene", "", "", "What the run is called and how long it lasts. Give exactly one of end_time and steps."},
+      {"scene", "name", "", "Name of the run; the default output folder is out/NAME."},
+      {"scene", "description", "", "One line shown by `rocklab list`."},
+      {"scene", "seed", "", "Seed of every random choice (insertion, orientations, bond strengths); equal seeds give equal runs."},
+      {"scene", "end_time", "s", "Simulated time at which the run ends (an experiment may end it earlier); 0 = use steps."},
+      {"scene", "steps", "", "Number of steps after which the run ends; 0 = use end_time."},
+
+      // --- [materials.NAME]
+      {"materials", "", "", "One sub-table per material, [materials.NAME]; walls and particle sources name it with `material`."},
+      {"materials.NAME", "", "", "One material. Stiffnesses are per entity: a contact puts the two entities' springs in series (docs/models.md)."},
+      {"materials.NAME", "colour", "", "Colour [r, g, b] of balls of this material in images, channels in [0, 1].", "[r, g, b], each in [0, 1]", "[0.56, 0.55, 0.52] (grey pebble)"},
+      {"materials.NAME", "density", "kg/m^3", "Density of the balls (walls ignore it)."},
+      {"materials.NAME", "kn", "N/m", "Normal stiffness of this entity (linear law, Eq 2-20)."},
+      {"materials.NAME", "ks", "N/m", "Shear stiffness of this entity (linear law, Eq 2-21).", nullptr, "kn"},
+      {"materials.NAME", "friction", "", "Coulomb friction coefficient; a contact uses the smaller of its two entities' (Eq 2-39)."},
+      {"materials.NAME", "shear_modulus", "Pa", "Shear modulus G (Hertz-Mindlin law, Eq 2-22; required > 0 with that law)."},
+      {"materials.NAME", "poisson", "", "Poisson's ratio (Hertz-Mindlin law)."},
+
+      // --- [contact]
+      {"contact", "", "", "The contact law of every ball-ball and ball-wall contact, its damping, and a stiffness scale."},
+      {"contact", "law", "", "Contact law: linear springs in series, or the study's simplified Hertz-Mindlin."},
+      {"contact", "damping_normal", "", "Critical damping ratio beta of the normal dashpot (Eq 2-17)."},
+      {"contact", "damping_shear", "", "Critical damping ratio of the shear dashpot.", nullptr, "damping_normal"},
+      {"contact", "damping_mass", "", "Mass of a ball-ball dashpot: the study's average of the two masses, or the reduced mass."},
+      {"contact", "local_damping", "", "Cundall's local damping alpha (Eq 2-15, sign form); 0 = off."},
+      {"contact", "stiffness_scale", "", "Factor on every material's kn, ks and shear_modulus (one key for a stiffness study)."},
+
+      // --- [gravity]
+      {"gravity", "", "", "Gravity at t = 0 and a schedule of changes (a chute experiment turns gravity itself)."},
+      {"gravity", "vector", "m/s^2", "Gravity at the start."},
+      {"gravity", "change", "", "[[gravity.change]]: gravity switches to `vector` at `time`."},
+      {"gravity.change", "", "", "One change of gravity; changes in increasing time order."},
+      {"gravity.change", "time", "s", "When gravity switches."},
+      {"gravity.change", "vector", "m/s^2", "Gravity from then on."},
+
+      // --- [timestep]
+      {"timestep", "", "", "The step is safety_factor x the critical step of the time-step audit (docs/models.md), lowered further by the damped cap."},
+      {"timestep", "safety_factor", "", "Fraction of the critical step used."},
+      {"timestep", "dt", "s", "Requested step; 0 = automatic. It may only lower the automatic step (unless allow_unsafe)."},
+      {"timestep", "impact_velocity", "m/s", "Impact speed of the Hertz contact-time line of the audit."},
+      {"timestep", "allow_unsafe", "", "Accept a dt above the automatic one (stability tests; the network check then runs every check_interval steps)."},
+
+      // --- [neighbours]
+      {"neighbours", "", "", "Verlet lists on a multi-level grid."},
+      {"neighbours", "skin", "m", "Verlet skin; 0 = 0.2 x the mean ball radius."},
+      {"neighbours", "max_levels", "", "Grid levels (one per doubling of the radius); 1 = one plain grid."},
+
+      // --- [watchdog]
+      {"watchdog", "", "", "Stops a run that blows up, naming the particle, the time and the setting to change (exit code 3)."},
+      {"watchdog", "max_overlap_fraction", "", "Overlap, as a fraction of the smaller radius, that stops the run (checked every step)."},
+      {"watchdog", "max_energy_growth", "", "Allowed rise of mechanical energy beyond the work of moving walls, fraction of its scale."},
+      {"watchdog", "check_interval", "", "Steps between energy checks (the overlap is checked every step, the energy also at every observed step)."},
+      {"watchdog", "network_iterations", "", "Power iterations of the contact-network step check; 0 = off."},
+      {"watchdog", "network_interval", "", "Steps between contact-network step checks."},
+
+      // --- [relaxation]
+      {"relaxation", "", "", "Initial overlaps kept as offsets that shrink to zero, so overlapping bodies are eased apart."},
+      {"relaxation", "steps", "", "Steps over which the initial overlaps are relaxed; 0 = off."},
+
+      // --- [[walls]]
+      {"walls", "", "", "A wall: plane, polygon, plate, mesh or box, with prescribed motion and an active time window. Keys by type are marked (plane), (polygon), ..."},
+      {"walls", "type", "", "Shape of the wall. A box makes five or six planes named NAME.floor, .xmin, .xmax, .ymin, .ymax, .top."},
+      {"walls", "name", "", "Name, for experiment keys and --set walls.NAME.KEY=...", nullptr, "walls.INDEX"},
+      {"walls", "material", "", "Material of the wall.", "a name under [materials]"},
+      {"walls", "active_from", "s", "The wall exists from this time on.", nullptr, "-inf (always)"},
+      {"walls", "active_until", "s", "The wall is removed at this time (a gate).", nullptr, "inf (never)"},
+      {"walls", "motion", "", "[walls.motion]: prescribed motion."},
+      {"walls", "point", "m", "(plane) A point of the plane."},
+      {"walls", "normal", "", "(plane) Normal pointing to where the balls are (need not be unit)."},
+      {"walls", "vertices", "m", "(polygon) Convex planar polygon, vertices in order; (mesh) vertices of the triangles."},
+      {"walls", "corner", "m", "(plate) Corner of the rectangle."},
+      {"walls", "length", "m", "(plate) Side along x, turned up by angle_deg about y."},
+      {"walls", "width", "m", "(plate) Side along y."},
+      {"walls", "angle_deg", "deg", "(plate) Angle of the length side above the x axis."},
+      {"walls", "file", "", "(mesh) STL, PLY or OBJ file, relative to the scene file."},
+      {"walls", "scale", "", "(mesh) Factor on the coordinates (0.001 for a file in mm)."},
+      {"walls", "triangles", "", "(mesh) Triangles as vertex indices [[i, j, k], ...], without `file`."},
+      {"walls", "min", "m", "(box) Lower corner."},
+      {"walls", "max", "m", "(box) Upper corner."},
+      {"walls", "open_top", "", "(box) Leave out the top face."},
+      {"walls", "colour", "", "Colour [r, g, b] in images.", "[r, g, b], each in [0, 1]", "[0.45, 0.45, 0.47]"},
+      {"walls", "opacity", "", "Opacity in images; < 1 is transparent (the Perspex the lab filmed through)."},
+      {"walls", "visible", "", "Draw the wall in images."},
+      {"walls", "plane_size", "m", "Side of the square drawn for an infinite plane."},
+      {"walls.motion", "", "", "x(t) = pivot + velocity t + amplitude sin(2 pi frequency t) + R(angular_velocity t) (x0 - pivot)."},
+      {"walls.motion", "velocity", "m/s", "Constant translation velocity."},
+      {"walls.motion", "angular_velocity", "rad/s", "Constant angular velocity about the pivot (not for infinite planes)."},
+      {"walls.motion", "pivot", "m", "Centre of the rotation."},
+      {"walls.motion", "amplitude", "m", "Amplitude of a sinusoidal oscillation."},
+      {"walls.motion", "frequency", "Hz", "Frequency of the oscillation; 0 = none."},
+
+      // --- [[particles]]
+      {"particles", "", "", "A source of spheres or clumps (lattice, random or list) or one bonded agglomerate. Keys by type or shape are marked."},
+      {"particles", "type", "", "How the bodies are placed: a lattice, random non-overlapping insertion, a list of positions, or an agglomerate."},
+      {"particles", "material", "", "Material of the balls.", "a name under [materials]"},
+      {"particles", "velocity", "m/s", "Initial velocity of every body (list: unless `velocities`)."},
+      {"particles", "shape", "", "Body shape: a sphere, the study's four-ball clump, or a clump file (x y z r per line)."},
+      {"particles", "radius", "m", "Sphere radius (lattice, list; random: or radius_min/radius_max); (agglomerate hcp) sphere radius; (agglomerate dense) r_max, the loose pack's radius.", nullptr, "required (see text)"},
+      {"particles", "radius_min", "m", "(random) Smallest radius; radii uniform in [radius_min, radius_max]."},
+      {"particles", "radius_max", "m", "(random) Largest radius."},
+      {"particles", "lattice", "", "(lattice) Simple, body-centred or face-centred cubic."},
+      {"particles", "cell", "m", "(lattice) Cell size."},
+      {"particles", "offset", "m", "(lattice) Offset of the first point from the corner."},
+      {"particles", "corner", "m", "(lattice) Corner of the lattice."},
+      {"particles", "counts", "", "(lattice) Cells along x, y, z (whole numbers, 1-10000)."},
+      {"particles", "region_min", "m", "(random) Lower corner of the insertion box."},
+      {"particles", "region_max", "m", "(random) Upper corner of the insertion box."},
+      {"particles", "count", "", "(random) Number of bodies; or solid_fraction.", nullptr, "none: count or solid_fraction"},
+      {"particles", "solid_fraction", "", "(random) Bodies to fill this fraction of the box volume (a size sweep fills the same space).", nullptr, "none: count or solid_fraction"},
+      {"particles", "positions", "m", "(list) Body positions (clumps: centres of mass)."},
+      {"particles", "radii", "m", "(list) One radius per position (spheres)."},
+      {"particles", "velocities", "m/s", "(list) One velocity per position."},
+      {"particles", "omegas", "rad/s", "(list) One angular velocity per position."},
+      {"particles", "random_orientation", "", "(clumps) Random orientation of every clump not placed by random insertion."},
+      {"particles", "member_radius", "m", "(four_ball) Radius of the four member spheres; or equivalent_diameter.", nullptr, "none: one of the two"},
+      {"particles", "equivalent_diameter", "m", "(four_ball) Diameter of the sphere of equal Eq 4-2 volume; sets member_radius.", nullptr, "none: one of the two"},
+      {"particles", "file", "", "(shape file) Clump file, one `x y z r` per line, relative to the scene."},
+      {"particles", "scale", "", "(shape file) Factor on the clump file's coordinates and radii."},
+      {"particles", "mass_distribution", "", "(clumps) How the mass is spread over the members for the inertia: the union at uniform density, equal member masses, or the plain sum of member spheres."},
+      {"particles", "mass", "kg", "(clumps) Clump mass; 0 = density x the mass_volume."},
+      {"particles", "mass_volume", "", "(clumps) Volume the mass is computed from: Eq 4-2 (four_ball only), the true union, or the sum of the members.", nullptr, "\"eq42\" (four_ball), \"union\" (file)"},
+      {"particles", "principal_inertia", "kg m^2", "(shape file) Principal moments about the file's axes, with `mass` (rocklab shape's clump.toml)."},
+      {"particles", "method", "", "(agglomerate) Hexagonal close packing, a dense random packing made at load time (§f.4, as `rocklab agglomerate --method dense`), or one agglomerate of a library made by `rocklab agglomerate`."},
+      {"particles", "diameter", "m", "(agglomerate hcp, dense) Diameter of the sphere the packing is cut to (dense: at least 4 r_max)."},
+      {"particles", "r0", "", "(agglomerate dense) Size ratio r_max / r_min of Eq 5-11: the voids are filled down to radius/r0."},
+      {"particles", "seed", "", "(agglomerate dense) The packing's own seed (scene.seed turns it when orientation = \"random\")."},
+      {"particles", "pack", "", "(agglomerate dense) The loose pack: DEM servo compaction to 100 kPa, or the geometric stand-in."},
+      {"particles", "hcp_angle", "deg", "(agglomerate hcp) Rotation about z of the layers stacked along y."},
+      {"particles", "gap_tolerance", "", "(agglomerate hcp, dense) Pairs closer than this fraction of the smaller radius are bonded."},
+      {"particles", "library", "", "(agglomerate library) Library file (LIB.h5), relative to the scene."},
+      {"particles", "index", "", "(agglomerate library) Which agglomerate of the library."},
+      {"particles", "rotation", "deg", "(agglomerate) Rotation about x, then y, then z (world axes)."},
+      {"particles", "orientation", "", "(agglomerate) \"random\" adds a seeded random rotation after `rotation`."},
+      {"particles", "position", "m", "(agglomerate) Centre of the agglomerate."},
+
+      // --- [bonds]
+      {"bonds", "", "", "The parallel-bond model (Eq 2-27 to 2-38) and the strengths of the agglomerates' bonds."},
+      {"bonds", "radius_multiplier", "", "phi of Eq 2-35: bond radius = phi x the smaller ball radius."},
+      {"bonds", "normal_stiffness", "Pa/m", "Normal stiffness per unit area (the study's \"N/m\" read as N/m^3)."},
+      {"bonds", "shear_stiffness", "Pa/m", "Shear stiffness per unit area."},
+      {"bonds", "failure_rule", "", "When a bond breaks: peak stress against strength (Eq 2-33, 2-34), or the sum of the four force and moment ratios."},
+      {"bonds", "tensile_strength", "Pa", "Normal strength sigma_c (the 37 % value of the Weibull draws)."},
+      {"bonds", "shear_strength", "Pa", "Shear strength tau_c.", nullptr, "tensile_strength"},
+      {"bonds", "strength_distribution", "", "One strength for all bonds, a Weibull draw per bond, or one Weibull factor per agglomerate on both strengths."},
+      {"bonds", "weibull_modulus", "", "Weibull modulus m of the draws (only with a Weibull distribution)."},
+
+      // --- [[cameras]]
+      {"cameras", "", "", "A pinhole camera with radial distortion (OpenCV's model) that renders frames at its own rate. Also the tables of a `rocklab render --camera` file."},
+      {"cameras", "name", "", "Name; files are NAME.mp4, NAME_still_*.png, frames/NAME/.", nullptr, "cameraINDEX"},
+      {"cameras", "resolution", "px", "[width, height] in whole pixels.", "two whole numbers in [16, 8192]", "[640, 480]"},
+      {"cameras", "fov_deg", "deg", "Horizontal field of view; or fx/fy/cx/cy.", nullptr, "none: fov_deg or fx"},
+      {"cameras", "fx", "px", "Focal length along x (without fov_deg)."},
+      {"cameras", "fy", "px", "Focal length along y.", nullptr, "fx"},
+      {"cameras", "cx", "px", "Principal point x.", nullptr, "(width - 1) / 2"},
+      {"cameras", "cy", "px", "Principal point y.", nullptr, "(height - 1) / 2"},
+      {"cameras", "k1", "", "First radial distortion coefficient."},
+      {"cameras", "k2", "", "Second radial distortion coefficient."},
+      {"cameras", "frame_rate", "1/s", "Frames per second of simulated time."},
+      {"cameras", "exposure", "s", "Exposure time (motion blur)."},
+      {"cameras", "eye", "m", "Camera position."},
+      {"cameras", "target", "m", "Point the camera looks at."},
+      {"cameras", "up", "", "Up direction of the image."},
+      {"cameras", "start_time", "s", "First frame."},
+      {"cameras", "end_time", "s", "No frames after this time.", nullptr, "inf"},
+      {"cameras", "movie", "", "Write NAME.mp4 (H.264; MJPG AVI as fallback)."},
+      {"cameras", "movie_fps", "1/s", "Playback rate of the movie."},
+      {"cameras", "still_interval", "s", "Simulated time between PNG stills; 0 = none."},
+      {"cameras", "all_frames", "", "Write every frame as PNG to frames/NAME/ (what the tracker reads)."},
+      {"cameras", "timestamp", "", "Time overlay on movie and stills."},
+      {"cameras", "scale_bar", "", "Scale bar on movie and stills."},
+      {"cameras", "scale_depth", "m", "Depth along the view at which the scale bar is true.", nullptr, "distance eye-target"},
+      {"cameras", "motion_blur", "", "Average sub-frames over the exposure (needs exposure > 0)."},
+      {"cameras", "noise_sigma", "", "Gaussian image noise, in grey levels."},
+      {"cameras", "light_gain", "", "Brightness factor."},
+
+      // --- [experiment]
+      {"experiment", "", "", "The experiment type and the keys every type has; the other keys depend on the type (tables below)."},
+      {"experiment", "type", "", "The driver: drop, heap, chute (also the zoned chute) or zwick."},
+      {"experiment", "sample_interval", "s", "Time between the driver's samples (the lab filmed at 500 frames/s)."},
+      {"experiment", "check_interval", "", "Renamed: use sample_interval (s); a scene that still has it is refused with that message.", "none", "none"},
+      {"experiment.drop", "", "", "type = \"drop\": one body dropped on a wall; restitution from the normal velocity before and after the impact. No keys of its own."},
+      {"experiment.heap", "", "", "type = \"heap\": bodies poured from a lifted tube (a wall with motion) settle into a heap; angle of repose."},
+      {"experiment.heap", "settle_speed", "m/s", "Settled when no body is faster."},
+      {"experiment.heap", "settle_min_time", "s", "Not settled before this time."},
+      {"experiment.heap", "settle_max_time", "s", "Give up settling at this time (reported, not hidden)."},
+      {"experiment.heap", "calibration_photos", "", "Checkerboard photos the side camera is calibrated from (3-11); 0 = the renderer's exact camera."},
+      {"experiment.heap", "base_z", "m", "Height of the table."},
+      {"experiment.heap", "bin_width", "m", "Silhouette bin width of the angle measurement."},
+      {"experiment.chute", "", "", "type = \"chute\": deposit, markers, tilt, gate opening, discharge. Frame: outlet at x = 0, base z = 0, camera wall y = 0."},
+      {"experiment.chute", "settle_speed", "m/s", "The deposit is settled when no body is faster."},
+      {"experiment.chute", "settle_min_time", "s", "Not settled before this time."},
+      {"experiment.chute", "settle_max_time", "s", "Give up settling at this time (reported)."},
+      {"experiment.chute", "calibration_photos", "", "Checkerboard photos the tracking camera is calibrated from (3-11); 0 = the renderer's exact camera."},
+      {"experiment.chute", "length", "m", "Length of the chute from the outlet to the feed end."},
+      {"experiment.chute", "inclination_deg", "deg", "Test inclination of the base."},
+      {"experiment.chute", "deposit_inclination_deg", "deg", "Inclination while depositing (zoned chute: 45)."},
+      {"experiment.chute", "gravity_tilt", "", "How the tilt enters: gravity rotated (its magnitude kept), or the study's added component g tan(angle) along the base."},
+      {"experiment.chute", "gate_wall", "", "Wall removed to release the flow.", "a wall name"},
+      {"experiment.chute", "top_wall", "", "Wall added after deposition (the zoned chute's top plate); bodies it cuts are removed.", "a wall name", "none"},
+      {"experiment.chute", "temporary_walls", "", "Walls removed after deposition (zone separators).", "wall names"},
+      {"experiment.chute", "tilt_steps", "", "Steps at the test inclination with the gate closed."},
+      {"experiment.chute", "marker_columns", "m", "Distances of the marker columns from the outlet, column 1 first."},
+      {"experiment.chute", "marker_heights", "m", "Marker heights above the base, the same in every column; or marker_height_fractions."},
+      {"experiment.chute", "marker_height_fractions", "", "Marker heights as fractions of the local channel height (top plate, else bed)."},
+      {"experiment.chute", "marker_y", "m", "Distance of the marker centres from the camera wall; 0 = one radius."},
+      {"experiment.chute", "measure_distance", "m", "Travel over which a marker's mean velocity is taken."},
+      {"experiment.chute", "remove_beyond", "m", "Bodies this far past the outlet are deleted."},
+      {"experiment.chute", "jam_time", "s", "No discharge for this long while bodies remain = jammed; the run stops."},
+      {"experiment.chute", "track", "", "Track the markers in the frames of track_camera."},
+      {"experiment.chute", "track_camera", "", "Camera whose frames are tracked.", "a camera name", "the first camera"},
+      {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
+      {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
+      {"experiment.zwick", "top_platen", "", "Plane wall that closes on the specimen.", "a plane wall name"},
+      {"experiment.zwick", "platen_speed", "m/s", "Closing speed of the top platen (Table 5.2: 0.008)."},
+      {"experiment.zwick", "settle_first", "", "Let the specimen settle on the bottom platen under gravity before loading."},
+      {"experiment.zwick", "settle_speed", "m/s", "(settle_first) Settled when no ball is faster."},
+      {"experiment.zwick", "settle_min_time", "s", "(settle_first) Not settled before this time."},
+      {"experiment.zwick", "settle_max_time", "s", "(settle_first) Give up settling at this time."},
+      {"experiment.zwick", "start_gap", "m", "Gap between the top platen and the specimen when loading starts."},
+      {"experiment.zwick", "sample_travel", "m", "Platen travel between samples while loading (0: every sample_interval)."},
+      {"experiment.zwick", "max_strain", "", "Loading ends when the platens have closed by this fraction of the specimen size."},
+      {"experiment.zwick", "failure_volume_fraction", "", "Failed once the pieces broken off the largest fragment exceed this fraction of the volume.", nullptr, "1/3"},
+      {"experiment.zwick", "end_drop", "", "After failure the test ends when the load has fallen below (1 - end_drop) x peak."},
+      {"experiment.zwick", "fines_size", "m", "Fragments of smaller equivalent diameter are fines (the lab's 8 mm sieve)."},
+
+      // --- [output]
+      {"output", "", "", "What the run writes into its output folder."},
+      {"output", "frame_interval", "s", "Time between trajectory frames in run.h5; 0 = first and last only."},
+      {"output", "energy_interval", "s", "Time between energy-log rows; 0 = at frames only."},
+      {"output", "checkpoint_interval", "s", "Time between checkpoints; 0 = at the end only."},
+      {"output", "hdf5", "", "Write run.h5."},
+      {"output", "vtk", "", "Write a ParaView series vtk/particles_*.vtp and particles.pvd."},
+      {"output", "checkpoint", "", "Write checkpoint.h5 (rocklab restart)."},
+  };
+  return docs;
+}
+
+namespace {
+
+/// Scenes that reach the reader branches the built-in scenes do not (every wall
+/// type, particle source and shape, the camera intrinsics, bond strengths).
+/// Paths are relative to the built-in scene folder; LIBRARY is replaced by a
+/// library file written for the purpose.
+const char* const kCoverageScenes[] = {
+    R"(
+[scene]
+name = "coverage-engine"
+steps = 1
+[materials.a]
+colour = [0.5, 0.5, 0.5]
+kn = 1e6
+ks = 1e6
+friction = 0.5
+shear_modulus = 1e9
+poisson = 0.25
+density = 2600
+[contact]
+law = "linear"
+damping_normal = 0.1
+damping_shear = 0.1
+damping_mass = "reduced"
+local_damping = 0.0
+stiffness_scale = 1.0
+[gravity]
+vector = [0, 0, -9.81]
+[[gravity.change]]
+time = 1.0
+vector = [0, 0, -1]
+[timestep]
+safety_factor = 0.3
+dt = 0
+impact_velocity = 2
+allow_unsafe = false
+[neighbours]
+skin = 0.001
+max_levels = 4
+[watchdog]
+max_overlap_fraction = 0.5
+max_energy_growth = 0.1
+check_interval = 100
+network_iterations = 2
+network_interval = 1000
+[relaxation]
+steps = 0
+[[walls]]
+type = "plane"
+name = "floor"
+material = "a"
+point = [0, 0, 0]
+normal = [0, 0, 1]
+active_from = 0
+active_until = 10
+colour = [0.2, 0.2, 0.2]
+opacity = 1
+visible = true
+plane_size = 1
+[walls.motion]
+velocity = [0, 0, 0]
+pivot = [0, 0, 0]
+amplitude = [0, 0, 0.001]
+frequency = 10
+[[walls]]
+type = "polygon"
+material = "a"
+vertices = [[0, 0, 1], [1, 0, 1], [1, 1, 1]]
+[[walls]]
+type = "plate"
+material = "a"
+corner = [0, 0, 2]
+length = 1
+width = 1
+angle_deg = 10
+[[walls]]
+type = "mesh"
+material = "a"
+file = "../meshes/pebble-1.stl"
+scale = 0.001
+[[walls]]
+type = "mesh"
+material = "a"
+vertices = [[0, 0, 3], [1, 0, 3], [0, 1, 3]]
+triangles = [[0, 1, 2]]
+[[walls]]
+type = "box"
+material = "a"
+min = [-1, -1, -1]
+max = [-0.5, -0.5, -0.5]
+open_top = false
+[[particles]]
+type = "lattice"
+material = "a"
+radius = 0.01
+lattice = "fcc"
+cell = 0.05
+offset = [0, 0, 0]
+corner = [5, 5, 5]
+counts = [2, 2, 2]
+velocity = [0, 0, 0]
+[[particles]]
+type = "random"
+material = "a"
+radius_min = 0.01
+radius_max = 0.012
+region_min = [5, 5, 6]
+region_max = [5.2, 5.2, 6.2]
+solid_fraction = 0.1
+[[particles]]
+type = "random"
+material = "a"
+radius = 0.01
+region_min = [5, 5, 7]
+region_max = [5.2, 5.2, 7.2]
+count = 3
+[[particles]]
+type = "list"
+material = "a"
+positions = [[6, 6, 6], [6.1, 6, 6]]
+radii = [0.01, 0.01]
+velocities = [[0, 0, 0], [0, 0, 0]]
+omegas = [[0, 0, 0], [0, 0, 0]]
+[[particles]]
+type = "list"
+material = "a"
+shape = "four_ball"
+member_radius = 0.005
+mass_distribution = "equal_mass"
+mass = 0.01
+random_orientation = false
+positions = [[7, 7, 7]]
+[[particles]]
+type = "list"
+material = "a"
+shape = "four_ball"
+equivalent_diameter = 0.02
+mass_volume = "union"
+positions = [[7.2, 7, 7]]
+[[particles]]
+type = "list"
+material = "a"
+shape = "file"
+file = "../clumps/pebble-1.txt"
+scale = 1.0
+mass = 0.01
+principal_inertia = [1e-7, 1.2e-7, 1.4e-7]
+positions = [[8, 8, 8]]
+[[cameras]]
+name = "pinhole"
+resolution = [320, 240]
+fx = 300
+fy = 300
+cx = 160
+cy = 120
+k1 = 0.01
+k2 = 0
+frame_rate = 100
+exposure = 0.001
+eye = [0, -1, 0.5]
+target = [0, 0, 0]
+up = [0, 0, 1]
+start_time = 0
+end_time = 1
+movie = false
+movie_fps = 25
+still_interval = 0
+all_frames = false
+timestamp = false
+scale_bar = false
+scale_depth = 1
+motion_blur = true
+noise_sigma = 1
+light_gain = 1
+[output]
+frame_interval = 0
+energy_interval = 0
+checkpoint_interval = 0
+hdf5 = false
+vtk = false
+checkpoint = false
+)",
+    R"(
+[scene]
+name = "coverage-bonds"
+end_time = 0.1
+[materials.rock]
+shear_modulus = 1e9
+[contact]
+law = "hertz_mindlin"
+[bonds]
+radius_multiplier = 1
+normal_stiffness = 1e12
+shear_stiffness = 1e12
+failure_rule = "combined"
+tensile_strength = 1e7
+shear_strength = 1e7
+strength_distribution = "weibull_per_bond"
+weibull_modulus = 3
+[[particles]]
+type = "agglomerate"
+material = "rock"
+method = "hcp"
+radius = 0.0025
+diameter = 0.012
+hcp_angle = 10
+gap_tolerance = 1e-3
+rotation = [0, 0, 0]
+orientation = "random"
+position = [0, 0, 0]
+velocity = [0, 0, 0]
+[[particles]]
+type = "agglomerate"
+material = "rock"
+method = "library"
+library = "LIBRARY"
+index = 0
+position = [1, 0, 0]
+)",
+};
+
+/// A library of one agglomerate (two bonded spheres) for the coverage scene.
+std::filesystem::path writeCoverageLibrary() {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("rocklab-scene-keys-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  AgglomerateRecord a;
+  a.method = "hcp";
+  a.r_max = 0.001;
+  a.r0 = 1;
+  a.diameter = 0.004;
+  a.spheres = {{geometry::Vec3(-0.001, 0, 0), 0.001}, {geometry::Vec3(0.001, 0, 0), 0.001}};
+  a.bonds = {{0, 1}};
+  a.sphere_count = 2;
+  a.bond_count = 1;
+  writeAgglomerateLibrary(dir / "lib.h5", {a});
+  return dir;
+}
+
+std::string cell(const std::string& s) { return s.empty() ? " " : s; }
+
+/// "a", "a or b" of the distinct non-empty strings of `values`, in order.
+std::string joined(const std::vector<std::string>& values, const std::string& sep) {
+  std::vector<std::string> seen;
+  for (const auto& v : values)
+    if (!v.empty() && std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
+  std::string out;
+  for (const auto& v : seen) out += (out.empty() ? "" : sep) + v;
+  return out;
+}
+
+std::string heading(const std::string& table) {
+  if (table == "walls" || table == "particles" || table == "cameras" || table == "gravity.change")
+    return "[[" + table + "]]";
+  if (table.rfind("experiment.", 0) == 0)
+    return "[experiment] type = \"" + table.substr(11) + "\"";
+  return "[" + table + "]";
+}
+
+}  // namespace
+
+std::string sceneKeysMarkdown(std::vector<std::string>& problems) {
+  // 1. Read the corpus with recording on.
+  detail::recordSceneKeys(true);
+  std::vector<std::filesystem::path> builtins;
+  for (const auto& e : std::filesystem::directory_iterator(builtinSceneDir()))
+    if (e.path().extension() == ".toml") builtins.push_back(e.path());
+  std::sort(builtins.begin(), builtins.end());
+  for (const auto& f : builtins) {
+    try {
+      loadScene(f);
+    } catch (const std::exception& e) {
+      problems.push_back(f.filename().string() + ": " + e.what());
+    }
+  }
+  const std::filesystem::path library_dir = writeCoverageLibrary();
+  for (std::string text : kCoverageScenes) {
+    if (const auto at = text.find("LIBRARY"); at != std::string::npos)
+      text.replace(at, 7, (library_dir / "lib.h5").string());
+    try {
+      loadSceneText(text, "coverage scene", {}, builtinSceneDir());
+    } catch (const std::exception& e) {
+      problems.push_back(std::string("coverage scene: ") + e.what());
+    }
+  }
+  std::filesystem::remove_all(library_dir);
+  const std::vector<detail::KeyRead> reads = detail::recordedSceneKeys();
+  detail::recordSceneKeys(false);
+
+  // 2. Join the reads with the documentation lines.
+  std::map<std::pair<std::string, std::string>, std::vector<const detail::KeyRead*>> read_by_key;
+  for (const auto& r : reads) read_by_key[{r.table, r.key}].push_back(&r);
+  std::set<std::pair<std::string, std::string>> documented;
+  for (const KeyDoc& d : sceneKeyDocs()) {
+    if (!documented.insert({d.table, d.key}).second)
+      problems.push_back(std::string("documented twice: ") + d.table + " " + d.key);
+  }
+  for (const auto& [id, rs] : read_by_key) {
+    const bool is_table = rs.front()->kind == "table" || rs.front()->kind == "array of tables";
+    const std::string name = (id.first.empty() ? "" : id.first + ".") + id.second;
+    if (!is_table && !documented.count(id))
+      problems.push_back("undocumented scene key '" + name +
+                         "': add its line to sceneKeyDocs() in experiments/src/scene/scene_keys.cpp");
+    if (is_table && !documented.count({name, ""}))
+      problems.push_back("undocumented table [" + name + "]: add its line {\"" + name +
+                         "\", \"\", ...} to sceneKeyDocs()");
+  }
+
+  std::ostringstream md;
+  md << "# Scene file reference\n\n"
+        "<!-- Generated by `rocklab scene-keys` from the scene readers; do not edit.\n"
+        "     Regenerate: build/app/rocklab scene-keys > docs/scene-format.md -->\n\n"
+        "Every table and key a scene file may hold, as the readers read it: the type, the\n"
+        "unit (SI), the values allowed, the default and what it does. It is generated by\n"
+        "`rocklab scene-keys`, which loads every built-in scene and a few coverage scenes\n"
+        "with the readers recording each key they ask for, and joins those records with\n"
+        "one line of documentation per key (`experiments/src/scene/scene_keys.cpp`). The\n"
+        "test `scene-keys` fails when a reader reads a key without a line there, when a\n"
+        "line names a key no reader reads, or when this file differs from the command's\n"
+        "output.\n\n"
+        "General rules:\n\n"
+        "- A scene is a TOML file. Units are SI (m, s, kg, N, Pa; angles in degrees where the\n"
+        "  key says `_deg`).\n"
+        "- `extends = \"other.toml\"` at the top takes every key of that scene (path relative\n"
+        "  to this file) and lays this file's keys over it: tables merge key by key, anything\n"
+        "  else (values, arrays, arrays of tables such as `[[walls]]`) replaces the base's.\n"
+        "- Every key is checked when the scene is loaded: an unknown key, a wrong type, a\n"
+        "  value out of range or a missing file stops with one message naming the file, line,\n"
+        "  key, value and what is allowed (exit code 2), before anything is written.\n"
+        "- `--set key.path=value` (run, check, sweep, study) overrides any key with a TOML\n"
+        "  value; `particles.0.count=200` indexes an array of tables, `walls.gate.active_until=0.3`\n"
+        "  finds an entry by its `name`.\n"
+        "- \"required\" means the key has no default; keys marked (plane), (lattice), ... are\n"
+        "  read only for that type or shape.\n\n";
+
+  // The top-level tables as a list, then one section per table.
+  std::string current;
+  for (const KeyDoc& d : sceneKeyDocs()) {
+    const std::string table = d.table;
+    const std::string key = d.key;
+    if (table.empty()) continue;
+    if (key.empty()) {
+      if (!current.empty()) md << "\n";
+      current = table;
+      md << "## " << heading(table) << "\n\n" << d.text << "\n\n";
+      // A table without keys of its own (experiment.drop) gets no key table.
+      bool has_keys = false;
+      for (const KeyDoc& k : sceneKeyDocs())
+        if (table == k.table && *k.key) has_keys = true;
+      if (has_keys)
+        md << "| key | type | unit | allowed | default | meaning |\n|---|---|---|---|---|---|\n";
+      continue;
+    }
+    if (table != current) {
+      problems.push_back("documentation line of " + table + "." + key +
+                         " is not in its table's group (after the line with key \"\")");
+      continue;
+    }
+    const auto found = read_by_key.find({table, key});
+    if (found == read_by_key.end()) {
+      problems.push_back("documented key '" + table + "." + key +
+                         "' is read by no scene of the corpus: removed from the reader, or a branch the "
+                         "coverage scenes of scene_keys.cpp do not reach");
+      continue;
+    }
+    std::vector<std::string> kinds, allowed, defaults;
+    for (const detail::KeyRead* r : found->second) {
+      if (r->kind.empty()) continue;  // has(): only asked about
+      kinds.push_back(r->kind);
+      if (r->kind == "table" || r->kind == "array of tables") continue;
+      allowed.push_back(r->allowed == "any number" ? "" : r->allowed);
+      defaults.push_back(r->required ? "required" : r->fallback);
+    }
+    // A key only asked about with has() (a renamed key that is refused with its new
+    // name) is documented by its `values` line; any other must be read somewhere.
+    if (kinds.empty() && !d.values) {
+      problems.push_back("key '" + table + "." + key +
+                         "' is only asked about (has()) in the corpus: read it in a coverage scene");
+      continue;
+    }
+    const std::string kind = kinds.empty() ? std::string("(refused)") : joined(kinds, " or ");
+    std::string values = d.values ? d.values : joined(allowed, "; ");
+    if (values == "true, false") values.clear();
+    const std::string fallback_list = joined(defaults, " / ");
+    if (!d.fallback && fallback_list.find(" / ") != std::string::npos)
+      problems.push_back("key '" + table + "." + key + "' has different defaults in different scenes (" +
+                         fallback_list + "): give its default text in scene_keys.cpp");
+    // The reader's own default as TOML text; a documentation line's default, or
+    // "required", as words.
+    const bool is_table = kind == "table" || kind == "array of tables";
+    std::string fallback = d.fallback ? d.fallback : fallback_list;
+    if (!d.fallback && fallback != "required" && !fallback.empty()) fallback = "`" + fallback + "`";
+    md << "| `" << key << "` | " << kind << " | " << cell(d.unit) << " | " << cell(values) << " | "
+       << cell(is_table ? std::string() : fallback) << " | " << d.text << " |\n";
+  }
+  // Top-level keys: the table list.
+  std::ostringstream top;
+  top << "## Top level\n\n| table | meaning |\n|---|---|\n";
+  for (const KeyDoc& d : sceneKeyDocs())
+    if (!*d.table) {
+      if (!read_by_key.count({"", d.key}))
+        problems.push_back(std::string("documented table '") + d.key + "' is read by no scene of the corpus");
+      top << "| " << heading(d.key) << " | " << std::string(d.text).substr(std::string(d.text).find(':') + 2)
+          << " |\n";
+    }
+  std::string out = md.str();
+  const auto first_section = out.find("\n## ");
+  out.insert(first_section + 1, top.str() + "\n");
+  return out;
+}
+
+}  // namespace rocklab::experiments
