@@ -68,6 +68,23 @@ struct HertzMindlinLaw {
   }
 };
 
+/// The stored shear force turned into the current tangent plane (normal n),
+/// keeping its magnitude ([X] note (i) of §3).
+[[gnu::always_inline]] inline void carryShear(Vec3& shear, const Vec3& n) {
+  const double sn = shear.dot(n);
+  if (sn != 0.0) {
+    shear -= sn * n;
+    const double new_mag2 = shear.squaredNorm();
+    // Restore the magnitude: factor sqrt(1 + x), x = sn^2 / |s_t|^2. The normal
+    // turns by a tiny angle per step, so x is tiny and the series
+    // 1 + x/2 - x^2/8 is exact to round-off (error x^3/16) without a square root.
+    if (new_mag2 > 0.0) {
+      const double x = sn * sn / new_mag2;
+      shear *= x < 1e-4 ? 1.0 + x * (0.5 - 0.125 * x) : std::sqrt(1.0 + x);
+    }
+  }
+}
+
 /// Evaluates one contact and updates its shear-force history `shear` (force on A).
 template <class Law>
 [[gnu::always_inline]] inline ContactResult evaluateContact(const PairProps& p, const ContactModel& cm,
@@ -84,19 +101,8 @@ template <class Law>
   const double fn_total = fn_elastic - cn * vn;
 
   // Shear spring: rotate the stored force into the current tangent plane keeping
-  // its magnitude ([X] note (i) of §3), then add the increment (Eq 2-3..2-5).
-  const double sn = shear.dot(n);
-  if (sn != 0.0) {
-    shear -= sn * n;
-    const double new_mag2 = shear.squaredNorm();
-    // Restore the magnitude: factor sqrt(1 + x), x = sn^2 / |s_t|^2. The normal
-    // turns by a tiny angle per step, so x is tiny and the series
-    // 1 + x/2 - x^2/8 is exact to round-off (error x^3/16) without a square root.
-    if (new_mag2 > 0.0) {
-      const double x = sn * sn / new_mag2;
-      shear *= x < 1e-4 ? 1.0 + x * (0.5 - 0.125 * x) : std::sqrt(1.0 + x);
-    }
-  }
+  // its magnitude, then add the increment (Eq 2-3..2-5).
+  carryShear(shear, n);
   const double ks = Law::shear(p, fn_elastic, g.r_tilde);
   shear += (ks * dt) * vt;  // B moving along +vt drags A along +vt
   // Coulomb limit on the elastic normal force (Eq 2-39). While slipping, the
@@ -112,6 +118,28 @@ template <class Law>
     if (cm.damping_shear > 0) ft += dashpot(cm.damping_shear, g.damping_mass, ks) * vt;
   }
   return {ft - fn_total * n};
+}
+
+/// A contact bond (dem-models §8.1): the contact with its no-tension and slip
+/// rules replaced by the bond's linear springs kn, ks (N/m). Normal force
+/// kn (U - reference_overlap), positive in compression, for any overlap U (m; a
+/// gap is U < 0), so separation builds tension; incremental shear spring
+/// (Eq 2-3..2-5) with no Coulomb cap; both dashpots (Eq 2-16..2-18) always on,
+/// as on a sticking contact. Updates `shear` (spring force on A, N) and returns
+/// the force on A; `fn_elastic` is the normal spring's force (N).
+inline ContactResult evaluateBondedContact(double kn, double ks, double reference_overlap,
+                                           const ContactModel& cm, const ContactGeometry& g,
+                                           double dt, Vec3& shear, double& fn_elastic) {
+  const Vec3& n = g.normal;
+  fn_elastic = kn * (g.overlap - reference_overlap);
+  const double vn = g.rel_velocity.dot(n);
+  const Vec3 vt = g.rel_velocity - vn * n;
+  const double cn = cm.damping_normal > 0 ? dashpot(cm.damping_normal, g.damping_mass, kn) : 0.0;
+  carryShear(shear, n);
+  shear += (ks * dt) * vt;
+  Vec3 ft = shear;
+  if (cm.damping_shear > 0 && ks > 0) ft += dashpot(cm.damping_shear, g.damping_mass, ks) * vt;
+  return {ft - (fn_elastic - cn * vn) * n};
 }
 
 /// Elastic energy stored at a contact (normal + shear spring).

@@ -113,8 +113,10 @@ std::vector<Mat3> World::particleStress() const {
     const std::uint32_t i = b.a[k], j = b.b[k];
     const Vec3 point = bondPoint(p.position[i], p.radius[i], p.radius[j], b.normal[k],
                                  (p.position[j] - p.position[i]).norm());
-    sum[j] += stressMoment(point - p.position[j], w.bonds.force_b[k]);
-    sum[i] += stressMoment(point - p.position[i], -w.bonds.force_b[k]);
+    // The bond's elastic force on j (Eq 2-27; a contact bond's springs, no dashpots).
+    const Vec3 on_j = b.normal_force[k] * b.normal[k] + b.shear_force[k];
+    sum[j] += stressMoment(point - p.position[j], on_j);
+    sum[i] += stressMoment(point - p.position[i], -on_j);
   }
   for (std::size_t i = 0; i < p.size(); ++i)
     sum[i] /= 4.0 / 3.0 * std::numbers::pi * std::pow(p.radius[i], 3);

@@ -16,7 +16,8 @@ constexpr double kMaxCellsPerBall = 8.0;
 
 void NeighborFinder::build(std::span<const Vec3> position, std::span<const double> radius,
                            double skin, int threads, PairList& out, int max_levels,
-                           std::span<const std::int32_t> group) {
+                           std::span<const std::int32_t> group,
+                           std::span<const std::uint64_t> excluded) {
   const std::size_t n = position.size();
   out.row_offset.assign(n + 1, 0);
   out.col_offset.assign(n + 1, 0);
@@ -134,6 +135,16 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
   keys_.clear();
   for (auto& k : thread_keys_) keys_.insert(keys_.end(), k.begin(), k.end());
   std::sort(keys_.begin(), keys_.end());
+  if (!excluded.empty()) {
+    // Both ascending: one merge pass drops the excluded pairs.
+    std::size_t kept = 0, e = 0;
+    for (const std::uint64_t key : keys_) {
+      while (e < excluded.size() && excluded[e] < key) ++e;
+      if (e < excluded.size() && excluded[e] == key) continue;
+      keys_[kept++] = key;
+    }
+    keys_.resize(kept);
+  }
 
   // Rows by i (keys are sorted by (i, j)), then the transpose by j.
   out.partner.resize(keys_.size());

@@ -30,10 +30,12 @@ class NeighborFinder {
  public:
   /// Rebuilds `out` for the given balls. `threads` as for OpenMP num_threads.
   /// Balls with the same `group` >= 0 (members of one clump) never pair; an empty
-  /// `group` means every ball is on its own.
+  /// `group` means every ball is on its own. Nor do the pairs of `excluded`
+  /// (keys i << 32 | j, i < j, ascending: pairs held by contact bonds).
   void build(std::span<const Vec3> position, std::span<const double> radius, double skin,
              int threads, PairList& out, int max_levels = 8,
-             std::span<const std::int32_t> group = {});
+             std::span<const std::int32_t> group = {},
+             std::span<const std::uint64_t> excluded = {});
 
  private:
   struct Level {

@@ -93,6 +93,14 @@ void auditBonds(const Model& model, const ParticleState& p, const BondState& bon
   const double kn = model.bonds.normal_stiffness, ks = model.bonds.shear_stiffness;
   for (std::size_t k = 0; k < bonds.size(); ++k) {
     if (!bonds.intact[k]) continue;
+    if (bonds.kind[k] == static_cast<std::uint8_t>(BondKind::Contact)) {
+      // A contact bond (§8.1): its normal spring, and its shear spring on the lever.
+      for (const std::uint32_t i : {bonds.a[k], bonds.b[k]}) {
+        k_tran[i] += bonds.spring_normal[k];
+        k_rot[i] += bonds.spring_shear[k] * p.radius[i] * p.radius[i];
+      }
+      continue;
+    }
     const BondDisc d = bondDisc(bonds.radius[k]);
     const double bend_twist = std::max(kn * d.inertia, ks * d.polar);
     for (const std::uint32_t i : {bonds.a[k], bonds.b[k]}) {

@@ -65,7 +65,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   }
   if (plan.bonds) {
     StageTimer timer(stageSeconds(Stage::Bonds));
-    bondStage();  // 4
+    bondStage(checks);  // 4
   }
   if (!contributions.empty()) {
     StageTimer timer(stageSeconds(Stage::ExtraForces));
@@ -124,6 +124,9 @@ WorldState World::exportState() const {
       if (!w.history.pair_shear[k].isZero(0) || (w.relax.active() && w.relax.pair[k] > 0))
         s.pair_history.push_back({static_cast<std::uint32_t>(i), w.nb.pairs.partner[k], w.history.pair_shear[k],
                                   w.relax.active() ? w.relax.pair[k] : 0.0});
+  // Pairs of contact bonds broken in the last step, not yet in the pair list.
+  for (const PairHistory& h : w.bonds.handover)
+    if (!h.shear.isZero(0)) s.pair_history.push_back(h);
   for (std::size_t i = 0; i + 1 < w.nb.wall_offset.size(); ++i)
     for (std::uint32_t c = w.nb.wall_offset[i]; c < w.nb.wall_offset[i + 1]; ++c)
       if (!w.history.wall_shear[c].isZero(0) || (w.relax.active() && w.relax.wall[c] > 0))

@@ -81,6 +81,18 @@ struct ContactPoint {
   return true;
 }
 
+/// The same geometry whether they touch or not (overlap < 0: the gap), for
+/// contact bonds (§8.1), which hold a pair apart too. Bit for bit what
+/// ballBallTouch gives when they touch.
+[[gnu::always_inline]] inline void ballBallGeometry(const Vec3& xi, const Vec3& xj, double ri, double rj,
+                                                    ContactPoint& g) {
+  const Vec3 d = xj - xi;
+  const double dist = std::sqrt(d.squaredNorm());
+  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
+  g.overlap = (ri + rj) - dist;
+  g.point = xi + g.normal * (ri - 0.5 * g.overlap);
+}
+
 /// A ball against an active wall; false when apart or the wall is not there.
 [[gnu::always_inline]] inline bool ballWallTouch(const detail::WallRuntime& runtime, const Wall& wall,
                                                  const Vec3& xi, double ri, ContactPoint& g) {
@@ -131,15 +143,24 @@ struct World::Impl {
   std::vector<detail::WallRuntime> walls;  // pose and activity at t (stage 1)
   std::vector<std::shared_ptr<ForceContribution>> contributions;  // stage 5, in this order
 
-  // --- parallel bonds (stage 4 writes; saved by exportState); empty without bonds
+  // --- bonds, parallel and contact (stage 4 writes; saved by exportState); empty without bonds
   struct Bonds {
+    // broke[k]: how bond k broke at this step (0: it did not); kActs: its force
+    // still acts in this step (a contact bond's shear break, §8.1).
+    static constexpr std::uint8_t kTensile = 1, kShear = 2, kActs = 4;
     BondState state;
     std::size_t intact = 0;                   // bonds not yet broken
+    std::size_t contact_intact = 0;           // of them contact bonds (their pairs are not in nb.pairs)
     std::vector<std::uint32_t> ball_offset;   // [n+1] rows of ball_end by ball
     std::vector<std::uint32_t> ball_end;      // 2 bond + (0: the ball is a, 1: it is b), by bond
     std::vector<Vec3> force_b;                // [bonds] N, this step's force on b (on a: minus it)
     std::vector<Vec3> torque_a, torque_b;     // [bonds] N m, about each ball's centre
-    std::vector<std::uint8_t> broke;          // [bonds] 1 when it broke at this step
+    std::vector<std::uint8_t> broke;          // [bonds] kTensile | kShear | kActs at this step
+    std::vector<Vec3> handover_shear;         // [bonds] N, contact bonds only: the shear spring on
+                                              // min(a, b) its ordinary contact starts from
+    // Contact bonds broken since the last neighbour build: the shear springs their
+    // pairs' ordinary contacts start from (taken at the next build; exported).
+    std::vector<PairHistory> handover;
     std::vector<BondBreak> breaks;            // every breakage since this World was built
     bool any() const { return state.size() > 0; }
   } bonds;
@@ -255,8 +276,15 @@ struct World::Impl {
   bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
   template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
-  // 4. bonds (stages/bonds.cpp)
-  void bondStage();
+  // 4. bonds (stages/bonds.cpp; contact bonds in stages/contact_bonds.cpp)
+  void bondStage(StepChecks& checks);
+  template <class Law> std::uint8_t contactBondStep(std::size_t k, StepChecks& c);
+  std::uint8_t contactBondStepAny(std::size_t k, StepChecks& c);
+  void installContactBond(std::size_t k);
+  std::vector<std::uint64_t> contactBondedPairs() const;
+  void takeHandovers();
+  double contactBondEnergy(std::size_t k) const;
+  NetworkSpring contactBondSpring(std::size_t k) const;
   void installBonds(const std::vector<BondSpec>& specs);
   void indexBonds();
   double bondEnergy() const;

@@ -102,19 +102,23 @@ std::string bondEndsProblem(std::size_t k, std::uint32_t a, std::uint32_t b, std
 std::string validateBonds(const ParallelBondModel& bm, const ParticleState& p, const BondState& bonds) {
   if (bonds.size() == 0) return {};
   std::ostringstream e;
-  if (!(bm.radius_multiplier > 0) || !std::isfinite(bm.radius_multiplier)) {
+  constexpr auto kContact = static_cast<std::uint8_t>(BondKind::Contact);
+  const bool any_parallel =
+      std::any_of(bonds.kind.begin(), bonds.kind.end(), [](std::uint8_t k) { return k != kContact; });
+  if (any_parallel && (!(bm.radius_multiplier > 0) || !std::isfinite(bm.radius_multiplier))) {
     e << "bonds.radius_multiplier = " << bm.radius_multiplier << ": must be > 0";
     return e.str();
   }
-  if (!(bm.normal_stiffness > 0) || !std::isfinite(bm.normal_stiffness)) {
+  if (any_parallel && (!(bm.normal_stiffness > 0) || !std::isfinite(bm.normal_stiffness))) {
     e << "bonds.normal_stiffness = " << bm.normal_stiffness << " Pa/m: must be > 0";
     return e.str();
   }
-  if (!(bm.shear_stiffness >= 0) || !std::isfinite(bm.shear_stiffness)) {
+  if (any_parallel && (!(bm.shear_stiffness >= 0) || !std::isfinite(bm.shear_stiffness))) {
     e << "bonds.shear_stiffness = " << bm.shear_stiffness << " Pa/m: must be >= 0";
     return e.str();
   }
   const std::size_t n = p.size();
+  std::vector<std::uint64_t> contact_pairs;  // a pair has one contact bond at most
   for (std::size_t k = 0; k < bonds.size(); ++k) {
     const std::uint32_t a = bonds.a[k], b = bonds.b[k];
     if (std::string bad = bondEndsProblem(k, a, b, n); !bad.empty()) return bad;
@@ -122,15 +126,36 @@ std::string validateBonds(const ParallelBondModel& bm, const ParticleState& p, c
       e << "bond " << k << ": balls " << a << " and " << b << " are members of one rigid clump";
       return e.str();
     }
-    if (!(bonds.tensile_strength[k] > 0) || !(bonds.shear_strength[k] > 0)) {
-      e << "bond " << k << ": strengths must be > 0 Pa (tensile " << bonds.tensile_strength[k] << ", shear "
-        << bonds.shear_strength[k] << ")";
+    if (bonds.kind[k] > kContact) {
+      e << "bond " << k << ": kind " << int(bonds.kind[k]) << " (0 parallel, 1 contact)";
       return e.str();
+    }
+    const bool contact = bonds.kind[k] == kContact;
+    if (!(bonds.tensile_strength[k] > 0) || !(bonds.shear_strength[k] > 0)) {
+      e << "bond " << k << ": strengths must be > 0 " << (contact ? "N" : "Pa") << " (tensile "
+        << bonds.tensile_strength[k] << ", shear " << bonds.shear_strength[k] << ")";
+      return e.str();
+    }
+    if (contact) {
+      if (!(bonds.spring_normal[k] > 0) || !std::isfinite(bonds.spring_normal[k]) ||
+          !(bonds.spring_shear[k] >= 0) || !std::isfinite(bonds.spring_shear[k]) ||
+          !std::isfinite(bonds.reference_overlap[k])) {
+        e << "contact bond " << k << ": springs must be finite, normal > 0 N/m (" << bonds.spring_normal[k]
+          << "), shear >= 0 N/m (" << bonds.spring_shear[k] << ")";
+        return e.str();
+      }
+      contact_pairs.push_back((std::uint64_t(std::min(a, b)) << 32) | std::max(a, b));
+      continue;
     }
     if (!(bonds.radius[k] > 0) || !bonds.normal[k].allFinite() || std::abs(bonds.normal[k].norm() - 1.0) > 1e-6) {
       e << "bond " << k << ": radius must be > 0 m and the normal a unit vector";
       return e.str();
     }
+  }
+  std::sort(contact_pairs.begin(), contact_pairs.end());
+  if (const auto twice = std::adjacent_find(contact_pairs.begin(), contact_pairs.end()); twice != contact_pairs.end()) {
+    e << "balls " << (*twice >> 32) << " and " << (*twice & 0xffffffffu) << " have two contact bonds (one at most)";
+    return e.str();
   }
   return {};
 }

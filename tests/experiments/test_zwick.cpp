@@ -2,9 +2,11 @@
 // and the scene's agglomerate and [bonds] tables.
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -116,6 +118,71 @@ TEST_CASE("zwick: bonds of constant or Weibull strength; bad bond and platen key
              Catch::Contains("no wall called 'lid'"));
   CHECK_THAT(sceneError({"particles.0.hcp_angle=120"}), Catch::Contains("hcp_angle"));
   CHECK_THAT(sceneError({"particles.0.diameter=0.004"}), Catch::Contains("two sphere radii"));
+}
+
+TEST_CASE("zwick: [bonds] type gives contact bonds (strengths in N); keys of the other kind are refused",
+          "[experiment][zwick][bonds]") {
+  auto small = [](std::vector<std::string> keys) {
+    keys.insert(keys.end(), kSmall.begin(), kSmall.end());
+    return keys;
+  };
+  const std::size_t pairs = loadScene(kZwick, kSmall).bonds.size();
+  REQUIRE(pairs > 0);
+  // Both: the parallel bonds first (the agglomerate's range), then a contact bond per pair.
+  const Scene both = loadScene(kZwick, small({"bonds.type=\"parallel+contact\"",
+                                              "bonds.contact_normal_strength=40",
+                                              "bonds.contact_shear_strength=25"}));
+  REQUIRE(both.bonds.size() == 2 * pairs);
+  CHECK(both.agglomerates[0].bonds == pairs);
+  for (std::size_t k = 0; k < pairs; ++k) {
+    CHECK(both.bonds[k].kind == rocklab::sim::BondKind::Parallel);
+    CHECK(both.bonds[k].tensile_strength == 60e6);
+    const auto& glue = both.bonds[pairs + k];
+    CHECK(glue.kind == rocklab::sim::BondKind::Contact);
+    CHECK(glue.a == both.bonds[k].a);
+    CHECK(glue.b == both.bonds[k].b);
+    CHECK(glue.tensile_strength == 40.0);
+    CHECK(glue.shear_strength == 25.0);
+  }
+  // Weibull per agglomerate: one factor on every strength.
+  const Scene drawn = loadScene(kZwick, small({"bonds.type=\"parallel+contact\"",
+                                               "bonds.contact_normal_strength=40",
+                                               "bonds.strength_distribution=\"weibull_per_agglomerate\"",
+                                               "bonds.weibull_modulus=3"}));
+  CHECK(drawn.bonds.back().tensile_strength / 40.0 ==
+        Approx(drawn.bonds.front().tensile_strength / 60e6));
+
+  CHECK_THAT(sceneError({"bonds.type=\"glue\""}),
+             Catch::Contains("bonds.type") && Catch::Contains("parallel+contact"));
+  CHECK_THAT(sceneError({"bonds.type=\"contact\"", "bonds.contact_normal_strength=40"}),
+             Catch::Contains("bonds.radius_multiplier") && Catch::Contains("not with type = \"contact\""));
+  CHECK_THAT(sceneError({"bonds.contact_normal_strength=40"}),
+             Catch::Contains("bonds.contact_normal_strength") && Catch::Contains("not with type = \"parallel\""));
+  CHECK_THAT(sceneError({"bonds.type=\"parallel+contact\""}), Catch::Contains("contact_normal_strength"));
+  CHECK_THAT(sceneError({"bonds.type=\"parallel+contact\"", "bonds.contact_normal_strength=-3"}),
+             Catch::Contains("contact_normal_strength"));
+  // In a file: its name and line, the key, the value, what is allowed.
+  const fs::path file =
+      fs::temp_directory_path() / ("rocklab-contact-bonds-" + std::to_string(::getpid()) + ".toml");
+  std::string text;
+  {
+    std::ifstream in(kZwick);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t at = text.find("[bonds]\n") + 8;
+  text.insert(at, "type = \"glue\"\n");
+  const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  std::ofstream(file) << text;
+  std::string message = "accepted";
+  try {
+    loadScene(file.string());
+  } catch (const SceneError& e) {
+    message = e.what();
+  }
+  fs::remove(file);
+  CHECK_THAT(message, Catch::Contains(file.filename().string() + ":" + std::to_string(line)) &&
+                          Catch::Contains("key 'bonds.type' = \"glue\"") &&
+                          Catch::Contains("allowed: \"parallel\", \"contact\", \"parallel+contact\""));
 }
 
 TEST_CASE("zwick: an agglomerate from a library brings its spheres and bonds into the scene",

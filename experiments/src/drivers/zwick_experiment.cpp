@@ -185,11 +185,14 @@ void ZwickExperiment::writeCurve(const std::filesystem::path& out) const {
   detail::writeAtomically(out / "force_displacement.csv", csv.str());
   std::ostringstream breaks;
   breaks.precision(10);
-  breaks << "time_s,step,bond,ball_a,ball_b,mode,tensile_stress_Pa,shear_stress_Pa\n";
+  // Stresses for parallel bonds (0 for contact bonds), forces for both.
+  breaks << "time_s,step,bond,ball_a,ball_b,kind,mode,tensile_stress_Pa,shear_stress_Pa,normal_force_N,"
+            "shear_force_N\n";
   for (const sim::BondBreak& e : breaks_)
     breaks << e.time << ',' << e.step << ',' << e.bond << ',' << e.a << ',' << e.b << ','
-           << sim::bondFailureModeName(e.mode) << ',' << e.tensile_stress << ',' << e.shear_stress
-           << '\n';
+           << sim::bondKindName(e.kind) << ',' << sim::bondFailureModeName(e.mode) << ','
+           << e.tensile_stress << ',' << e.shear_stress << ',' << e.normal_force << ','
+           << e.shear_force << '\n';
   if (bond_count_ > 0) detail::writeAtomically(out / "bond_breaks.csv", breaks.str());
   PlotSeries curve{"top platen", {}, {}, PlotSeries::Style::Line};
   for (const ZwickSample& x : samples_) {

@@ -75,7 +75,11 @@ std::vector<std::string> activeModules(const Scene& scene, const sim::World& wor
     modules.push_back("walls:moving");
   if (!model.gravity_changes.empty()) modules.push_back("gravity:schedule");
   if (world.particles().clumps.size() > 0) modules.push_back("clumps");
-  if (world.bonds().size() > 0) modules.push_back("bonds:parallel");
+  for (const sim::BondKind kind : {sim::BondKind::Parallel, sim::BondKind::Contact}) {
+    const auto& k = world.bonds().kind;
+    if (std::find(k.begin(), k.end(), static_cast<std::uint8_t>(kind)) != k.end())
+      modules.push_back(std::string("bonds:") + sim::bondKindName(kind));
+  }
   if (has_experiment) modules.push_back("experiment:" + scene.experiment_type);
   if (!scene.cameras.empty())
     modules.push_back("render:" + std::to_string(scene.cameras.size()) + " camera(s)");

@@ -324,10 +324,19 @@ ParticleState readParticles(const Reader& in) {
   return p;
 }
 
+/// Bond fields that came with contact bonds (§8.1): files written before them
+/// hold parallel bonds only, which these fields' zeros describe.
+bool addedWithContactBonds(const std::string& name) {
+  return name == "kind" || name == "spring_normal" || name == "spring_shear" || name == "reference_overlap";
+}
+
 BondState readBonds(const Reader& in) {
   BondState b;
   if (!in.has("/bonds")) return b;  // a run without bonds
-#define ROCKLAB_READ(type, name, unit, meaning) b.name = in.array<type>("/bonds/" #name);
+  const std::size_t n = in.array<std::uint32_t>("/bonds/a").size();
+#define ROCKLAB_READ(type, name, unit, meaning)                                    \
+  b.name = !in.has("/bonds/" #name) && addedWithContactBonds(#name) ? std::vector<type>(n) \
+                                                                     : in.array<type>("/bonds/" #name);
   ROCKLAB_BOND_FIELDS(ROCKLAB_READ)
 #undef ROCKLAB_READ
   return b;

@@ -7,10 +7,13 @@ namespace rocklab::sim {
 
 // Stage 4, bonds: every intact parallel bond (bonds.h, dem-models.md §8.2) is
 // updated from the relative motion of its two balls, checked against its
-// strengths, and its force and moment are added into the balls' accumulators.
+// strengths, and its force and moment are added into the balls' accumulators;
+// so is every intact contact bond (§8.1, its update in contact_bonds.cpp).
 // Reads: positions at t, velocities and spins at t - dt/2; bonds.state.
 // Writes: bonds.state (forces, moments, frame; intact -> 0 on breakage), the
-// per-bond scratch, scratch.acc_force/acc_torque (adds), bonds.breaks.
+// per-bond scratch, scratch.acc_force/acc_torque (adds), bonds.breaks; after a
+// contact bond breaks, bonds.handover and nb.need_rebuild (its pair rejoins the
+// neighbour list at the next step); the overlap check of contact-bonded pairs.
 //
 // Threads: the update runs over bonds (each writes only its own entries), the
 // sums over balls, each adding its bonds in ascending bond order: bitwise the
@@ -19,6 +22,8 @@ namespace rocklab::sim {
 const char* bondFailureModeName(BondFailureMode mode) {
   return mode == BondFailureMode::Tensile ? "tensile" : "shear";
 }
+
+const char* bondKindName(BondKind kind) { return kind == BondKind::Parallel ? "parallel" : "contact"; }
 
 BondDisc bondDisc(double radius) {
   BondDisc d;
@@ -66,6 +71,10 @@ inline Vec3 twistAbout(const Vec3& v, const Vec3& n, double angle) {
   return c * v + s * n.cross(v);
 }
 
+// The step checks merged across threads (mergeChecks: max and or, any order).
+#pragma omp declare reduction(mergeStepChecks : StepChecks : mergeChecks(omp_out, omp_in)) \
+    initializer(omp_priv = StepChecks{})
+
 /// What one bond does in this step.
 struct BondOutcome {
   bool broke = false;
@@ -75,19 +84,30 @@ struct BondOutcome {
 
 }  // namespace
 
-void World::Impl::bondStage() {
+void World::Impl::bondStage(StepChecks& checks) {
   BondState& s = bonds.state;
   const ParallelBondModel& bm = model.bonds;
   const double kn = bm.normal_stiffness, ks = bm.shear_stiffness;
   const bool combined = bm.failure_rule == BondFailureRule::Combined;
   const auto nbonds = static_cast<std::ptrdiff_t>(s.size());
   const double h = dt;
+  constexpr auto kContact = static_cast<std::uint8_t>(BondKind::Contact);
   bool any_broke = false;
-#pragma omp parallel for schedule(static) num_threads(teamSize()) reduction(|| : any_broke)
+  StepChecks bonded;  // the overlaps of contact-bonded pairs
+#pragma omp parallel for schedule(static) num_threads(teamSize()) reduction(|| : any_broke) \
+    reduction(mergeStepChecks : bonded)
   for (std::ptrdiff_t kk = 0; kk < nbonds; ++kk) {
     const auto k = static_cast<std::size_t>(kk);
     bonds.broke[k] = 0;
     if (!s.intact[k]) continue;
+    if (s.kind[k] == kContact) {
+      if (const std::uint8_t how = contactBondStepAny(k, bonded)) {
+        s.intact[k] = 0;
+        bonds.broke[k] = how;
+        any_broke = true;
+      }
+      continue;
+    }
     const std::uint32_t a = s.a[k], b = s.b[k];
     const Vec3& xa = p.position[a];
     const Vec3& xb = p.position[b];
@@ -140,7 +160,7 @@ void World::Impl::bondStage() {
       // Deleted at once (ref §8.2): it carries nothing in the step it breaks, so
       // a pair whose bond breaks at once moves exactly as if never bonded.
       s.intact[k] = 0;
-      bonds.broke[k] = tensile_ratio >= shear_ratio ? 1 : 2;
+      bonds.broke[k] = tensile_ratio >= shear_ratio ? Bonds::kTensile : Bonds::kShear;
       bonds.force_b[k].setZero();
       bonds.torque_a[k].setZero();
       bonds.torque_b[k].setZero();
@@ -153,22 +173,32 @@ void World::Impl::bondStage() {
     bonds.torque_b[k] = m + (xc - xb).cross(f);
     bonds.torque_a[k] = -m - (xc - xa).cross(f);
   }
+  mergeChecks(checks, bonded);
   if (any_broke) {
     for (std::size_t k = 0; k < s.size(); ++k) {
       if (!bonds.broke[k]) continue;
       --bonds.intact;
-      const BondDisc disc = bondDisc(s.radius[k]);
       BondBreak e;
       e.time = time;
       e.step = step;
       e.bond = static_cast<std::uint32_t>(k);
       e.a = s.a[k];
       e.b = s.b[k];
-      e.mode = bonds.broke[k] == 1 ? BondFailureMode::Tensile : BondFailureMode::Shear;
-      const BondStress stress = bondStress(disc, s.normal_force[k], s.shear_force[k],
-                                           s.twist_moment[k], s.bend_moment[k]);
-      e.tensile_stress = stress.tensile;
-      e.shear_stress = stress.shear;
+      e.kind = static_cast<BondKind>(s.kind[k]);
+      e.mode = bonds.broke[k] & Bonds::kTensile ? BondFailureMode::Tensile : BondFailureMode::Shear;
+      e.normal_force = s.normal_force[k];
+      e.shear_force = s.shear_force[k].norm();
+      if (s.kind[k] == kContact) {
+        --bonds.contact_intact;
+        nb.need_rebuild = true;  // its pair rejoins the neighbour list
+        if (bonds.broke[k] & Bonds::kActs)
+          bonds.handover.push_back({std::min(e.a, e.b), std::max(e.a, e.b), bonds.handover_shear[k], 0.0});
+      } else {
+        const BondStress stress = bondStress(bondDisc(s.radius[k]), s.normal_force[k], s.shear_force[k],
+                                             s.twist_moment[k], s.bend_moment[k]);
+        e.tensile_stress = stress.tensile;
+        e.shear_stress = stress.shear;
+      }
       bonds.breaks.push_back(e);
     }
   }
@@ -178,7 +208,7 @@ void World::Impl::bondStage() {
     const auto i = static_cast<std::size_t>(ii);
     for (std::uint32_t e = bonds.ball_offset[i]; e < bonds.ball_offset[i + 1]; ++e) {
       const std::uint32_t k = bonds.ball_end[e] >> 1;
-      if (!s.intact[k]) continue;
+      if (!s.intact[k] && !(bonds.broke[k] & Bonds::kActs)) continue;
       if (bonds.ball_end[e] & 1u) {
         scratch.acc_force[i] += bonds.force_b[k];
         scratch.acc_torque[i] += bonds.torque_b[k];
@@ -211,8 +241,14 @@ void World::Impl::indexBonds() {
   bonds.torque_a.assign(s.size(), Vec3::Zero());
   bonds.torque_b.assign(s.size(), Vec3::Zero());
   bonds.broke.assign(s.size(), 0);
-  bonds.intact = 0;
-  for (std::uint8_t f : s.intact) bonds.intact += f ? 1 : 0;
+  bonds.intact = bonds.contact_intact = 0;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (!s.intact[k]) continue;
+    ++bonds.intact;
+    if (s.kind[k] == static_cast<std::uint8_t>(BondKind::Contact)) ++bonds.contact_intact;
+  }
+  // Only a world with contact bonds hands shear springs to contacts.
+  bonds.handover_shear.assign(bonds.contact_intact > 0 ? s.size() : 0, Vec3::Zero());
 }
 
 void World::Impl::installBonds(const std::vector<BondSpec>& specs) {
@@ -223,15 +259,20 @@ void World::Impl::installBonds(const std::vector<BondSpec>& specs) {
     const Vec3 d = p.position[b.b] - p.position[b.a];
     s.a.push_back(b.a);
     s.b.push_back(b.b);
+    s.kind.push_back(static_cast<std::uint8_t>(b.kind));
     s.radius.push_back(bm.radius_multiplier * std::min(ra, rb));  // Eq 2-35
     s.tensile_strength.push_back(b.tensile_strength);
     s.shear_strength.push_back(b.shear_strength);
+    s.spring_normal.push_back(0.0);
+    s.spring_shear.push_back(0.0);
+    s.reference_overlap.push_back(0.0);
     s.intact.push_back(1);
     s.normal.push_back(d.norm() > 0 ? Vec3(d.normalized()) : Vec3(Vec3::UnitZ()));
     s.normal_force.push_back(0.0);
     s.shear_force.push_back(Vec3::Zero());
     s.twist_moment.push_back(0.0);
     s.bend_moment.push_back(Vec3::Zero());
+    if (b.kind == BondKind::Contact) installContactBond(s.size() - 1);
   }
   indexBonds();
 }
@@ -243,6 +284,10 @@ double World::Impl::bondEnergy() const {
   double e = 0.0;
   for (std::size_t k = 0; k < s.size(); ++k) {
     if (!s.intact[k]) continue;
+    if (s.kind[k] == static_cast<std::uint8_t>(BondKind::Contact)) {
+      e += contactBondEnergy(k);
+      continue;
+    }
     const BondDisc d = bondDisc(s.radius[k]);
     e += 0.5 * s.normal_force[k] * s.normal_force[k] / (kn * d.area);
     e += 0.5 * s.bend_moment[k].squaredNorm() / (kn * d.inertia);
@@ -259,6 +304,10 @@ void World::Impl::bondSprings(std::vector<NetworkSpring>& out) const {
   const BondState& s = bonds.state;
   for (std::size_t k = 0; k < s.size(); ++k) {
     if (!s.intact[k]) continue;
+    if (s.kind[k] == static_cast<std::uint8_t>(BondKind::Contact)) {
+      out.push_back(contactBondSpring(k));
+      continue;
+    }
     const BondDisc d = bondDisc(s.radius[k]);
     const std::uint32_t a = s.a[k], b = s.b[k];
     const Vec3 n = s.normal[k];

@@ -39,6 +39,13 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
                                               history.wall_shear[c]);
     }
   }
+  // Contacts of contact bonds that broke in this step: not yet in the pair list.
+  for (const PairHistory& h : bonds.handover) {
+    ContactPoint touch;
+    if (!ballBallTouch(p.position[h.i], p.position[h.j], p.radius[h.i], p.radius[h.j], touch)) continue;
+    e.elastic += detail::elasticEnergy<Law>(pairProps(h.i, h.j), touch.overlap,
+                                            effectiveRadius(p.radius[h.i], p.radius[h.j]), h.shear);
+  }
   return e;
 }
 

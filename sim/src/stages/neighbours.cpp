@@ -3,9 +3,10 @@
 namespace rocklab::sim {
 
 // Stage 2, neighbours.
-// Reads: positions, radii, clump membership, wall poses; the old lists.
+// Reads: positions, radii, clump membership, intact contact bonds, wall poses; the old lists.
 // Writes: nb (pair list, wall candidates, reference positions), the contact
-// history and relaxation offsets carried over to the new lists, the thread
+// history and relaxation offsets carried over to the new lists (and the shear
+// springs of broken contact bonds' pairs: bonds.handover, emptied), the thread
 // ranges and cross-pair slots of the force pass (scratch); relaxation factor.
 
 void World::Impl::neighbourStage() {
@@ -21,7 +22,11 @@ void World::Impl::rebuildNeighbours() {
   std::vector<Vec3> old_shear = std::move(history.pair_shear);
   std::vector<double> old_relax = std::move(relax.pair);
   const bool carry_relax = !old_relax.empty();
-  nb.finder.build(p.position, p.radius, nb.skin, teamSize(), nb.pairs, model.max_grid_levels, p.clump);
+  // Pairs held by intact contact bonds (§8.1) have no ordinary contact.
+  const std::vector<std::uint64_t> bonded =
+      bonds.contact_intact > 0 ? contactBondedPairs() : std::vector<std::uint64_t>{};
+  nb.finder.build(p.position, p.radius, nb.skin, teamSize(), nb.pairs, model.max_grid_levels, p.clump,
+                  bonded);
   const std::size_t np = nb.pairs.size();
   history.pair_shear.assign(np, Vec3::Zero());
   history.pair_touch.assign(np, 0);
@@ -42,6 +47,7 @@ void World::Impl::rebuildNeighbours() {
       }
     }
   }
+  if (!bonds.handover.empty()) takeHandovers();  // pairs of contact bonds broken since the last build
   // Wall candidates: balls within r + skin of an active wall.
   std::vector<std::uint32_t> old_offset = std::move(nb.wall_offset), old_index = std::move(nb.wall_index);
   std::vector<Vec3> old_wshear = std::move(history.wall_shear);

@@ -54,7 +54,8 @@ struct ClumpShapeReport {
 
 /// One bonded agglomerate of the scene ([[particles]] type = "agglomerate"):
 /// its balls are scene.spheres[first_ball, first_ball + balls), its bonds
-/// scene.bonds[first_bond, first_bond + bonds).
+/// scene.bonds[first_bond, first_bond + bonds) (with bonds.type =
+/// "parallel+contact" the parallel ones; their contact bonds follow all of those).
 struct AgglomerateReport {
   std::string source;           // particles.N
   std::string method;           // "hcp", "dense" or "library:<its method>"
@@ -63,7 +64,7 @@ struct AgglomerateReport {
   double porosity = 0;          // -, against the bounding sphere
   double coordination_number = 0;  // bonds per ball (x 2)
   double solid_volume = 0;      // m^3
-  double bond_strength = 0;     // Pa, the agglomerate's own (constant or drawn) strength; 0 = per bond
+  double bond_strength = 0;     // Pa (N if contact bonds only), its own (constant or drawn) tensile strength; 0 = per bond
 };
 
 /// A virtual camera of the scene ([[cameras]]): frames are rendered only at its
@@ -101,7 +102,7 @@ struct Scene {
   std::vector<sim::SphereSpec> spheres;
   std::vector<sim::ClumpSpec> clumps;
   std::vector<ClumpShapeReport> clump_shapes;
-  std::vector<sim::BondSpec> bonds;  // parallel bonds between scene.spheres (model.bonds)
+  std::vector<sim::BondSpec> bonds;  // bonds between scene.spheres: parallel (model.bonds), contact
   std::vector<AgglomerateReport> agglomerates;
   RunSettings run;
   std::string experiment_type;  // "" (plain run) or a registered driver's type

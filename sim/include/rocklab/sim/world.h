@@ -12,8 +12,8 @@
 //                    in a fixed order; on steps that nothing observes, with no
 //                    intact bonds and no force contributions, fused with the
 //                    kick and drift (stage 8)
-//   4. bonds         parallel bonds (bonds.h): update, breakage, forces and
-//                    moments into the accumulators; only when the world has bonds
+//   4. bonds         parallel and contact bonds (bonds.h): update, breakage, forces
+//                    and moments into the accumulators; only when the world has bonds
 //   5. extra forces  force contributions (force_contribution.h) add into the
 //                    accumulators in a fixed order; only when present
 //   6. observe       only on observed steps: velocities synchronised to t, energy
@@ -99,8 +99,9 @@ class World {
   /// The same with rigid clumps; their member balls follow the free spheres.
   World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
         int threads = 0);
-  /// The same with parallel bonds (Model::bonds) between its balls, installed
-  /// stress-free where the balls are now.
+  /// The same with bonds between its balls: parallel ones (Model::bonds) installed
+  /// stress-free where the balls are now, contact ones (BondKind::Contact) with the
+  /// pair's contact force there (bonds.h). Throws std::invalid_argument for a bad bond.
   World(Model model, const std::vector<SphereSpec>& spheres, const std::vector<ClumpSpec>& clumps,
         const std::vector<BondSpec>& bonds, int threads = 0);
   /// Restarts from a saved state (dt is taken from the state).
