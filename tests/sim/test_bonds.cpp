@@ -8,7 +8,10 @@
 #include <filesystem>
 #include <numbers>
 
+#include <unistd.h>
+
 #include "rocklab/sim/output/checkpoint.h"
+#include "rocklab/sim/output/run_file.h"
 #include "sim/support.h"
 
 using namespace rocklab;
@@ -400,6 +403,39 @@ TEST_CASE("bond: restart from a checkpoint with broken bonds equals the uninterr
   CHECK(second.bonds().normal_force == whole.bonds().normal_force);
   // Broken bonds stayed broken: the restarted run logged only the later breaks.
   CHECK(second.bondBreaks().size() + broken_at_checkpoint == whole.bondBreaks().size());
+}
+
+TEST_CASE("bond: run.h5 frames record the breakage; the reader gives the fragments back",
+          "[bonds][output]") {
+  // The tension case above: the bond breaks in step 40.
+  const double dt = 1e-7, v = 0.01;
+  sim::World world = prescribedPair({Vec3(v, 0, 0), Vec3::Zero()},
+                                    bond(0, 1, 40.5 * kBondKn * v * dt, 1e30), dt);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("rocklab-test-bonds-runfile-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    sim::output::RunFile run(dir / "run.h5", "scene");
+    for (int s = 0; s < 60; ++s)
+      world.step(s % 20 == 0 ? [&](const sim::Snapshot& snap) { run.writeFrame(snap); }
+                             : std::function<void(const sim::Snapshot&)>{});
+    run.close(false);
+  }
+  REQUIRE(world.bondBreaks().size() == 1);
+  sim::output::RunFileReader reader(dir / "run.h5");
+  REQUIRE(reader.frameCount() == 3);  // steps 0, 20, 40
+  const std::vector<std::uint8_t> intact{1, 1, 0};
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("frame " << k);
+    const sim::Snapshot& s = reader.frame(k);
+    REQUIRE(s.bond_intact.size() == 1);
+    CHECK(s.bond_a[0] == 0);
+    CHECK(s.bond_b[0] == 1);
+    CHECK(s.bond_intact[0] == intact[k]);
+    const auto label = sim::bondedClusters(s.position.size(), s.bond_a, s.bond_b, s.bond_intact);
+    CHECK(label == (intact[k] ? std::vector<std::uint32_t>{0, 0} : std::vector<std::uint32_t>{0, 1}));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("bond: removal drops the bonds of removed balls and renumbers the rest", "[bonds]") {

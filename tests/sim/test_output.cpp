@@ -80,6 +80,9 @@ struct Frame {
     s.force = force;
     s.radius = radius;
     s.id = id;
+    s.bond_a = bond_a;
+    s.bond_b = bond_b;
+    s.bond_intact = bond_intact;
     s.energy = {1.5 + time, 0.25, -3.0 * time, 0.125};
     s.contacts = 7;
     return s;
@@ -89,6 +92,8 @@ struct Frame {
   std::vector<Vec3> position, velocity, omega, force;
   std::vector<double> radius;
   std::vector<std::uint64_t> id;
+  std::vector<std::uint32_t> bond_a, bond_b;  // empty: a world without bonds
+  std::vector<std::uint8_t> bond_intact;
 };
 
 fs::path partialOf(const fs::path& path) {
@@ -312,6 +317,114 @@ TEST_CASE("output: run file rejects snapshots whose arrays differ in length", "[
   Frame frame(3, 0.0, 0);
   frame.radius.pop_back();
   CHECK_THROWS_AS(run.writeFrame(frame.snapshot()), std::invalid_argument);
+  CHECK(run.frameCount() == 0);
+}
+
+TEST_CASE("output: run file bond state: ends once per file, intact flags per frame", "[output][bonds]") {
+  H5::Exception::dontPrint();
+  TempDir dir;
+  const fs::path path = dir / "run.h5";
+  Frame first(3, 0.0, 0), broken(3, 0.1, 10), renumbered(2, 0.2, 20), unbonded(2, 0.3, 30);
+  first.bond_a = broken.bond_a = {0, 1};
+  first.bond_b = broken.bond_b = {1, 2};
+  first.bond_intact = {1, 1};
+  broken.bond_intact = {1, 0};
+  renumbered.bond_a = {0};  // ball 2 removed: one bond left, its ends new to the file
+  renumbered.bond_b = {1};
+  renumbered.bond_intact = {1};
+  {
+    output::RunFile run(path, kScene);
+    for (const Frame* f : {&first, &broken, &renumbered, &unbonded}) run.writeFrame(f->snapshot());
+    run.close(false);
+  }
+  {
+    const H5::H5File file(path.string(), H5F_ACC_RDONLY);
+    CHECK(readValues<std::uint32_t>(file.openGroup("bonds"), "bond_a", H5::PredType::NATIVE_UINT32) == first.bond_a);
+    CHECK(readValues<std::uint32_t>(file.openGroup("bonds"), "bond_b", H5::PredType::NATIVE_UINT32) == first.bond_b);
+    const H5::Group f1 = file.openGroup("frames/000001");
+    CHECK(readValues<std::uint8_t>(f1, "bond_intact", H5::PredType::NATIVE_UINT8) == broken.bond_intact);
+    CHECK_FALSE(f1.nameExists("bond_a"));  // the file's ends hold
+    CHECK(file.openGroup("frames/000002").nameExists("bond_a"));  // its own, renumbered
+    CHECK(file.openGroup("frames/000003").getNumObjs() == 6);    // no bond dataset at all
+  }
+  output::RunFileReader reader(path);
+  REQUIRE(reader.frameCount() == 4);
+  auto vec = []<class T>(std::span<const T> s) { return std::vector<T>(s.begin(), s.end()); };
+  const std::array<const Frame*, 4> written{&first, &broken, &renumbered, &unbonded};
+  for (std::size_t k = 0; k < written.size(); ++k) {
+    INFO("frame " << k);
+    const Frame* f = written[k];
+    const Snapshot& s = reader.frame(k);
+    CHECK(vec(s.bond_a) == f->bond_a);
+    CHECK(vec(s.bond_b) == f->bond_b);
+    CHECK(vec(s.bond_intact) == f->bond_intact);
+  }
+}
+
+TEST_CASE("output: run file without bonds has no bond datasets", "[output][bonds]") {
+  H5::Exception::dontPrint();
+  TempDir dir;
+  {
+    output::RunFile run(dir / "run.h5", kScene);
+    run.writeFrame(Frame(3, 0.0, 0).snapshot());
+    run.close(false);
+  }
+  const H5::H5File file((dir / "run.h5").string(), H5F_ACC_RDONLY);
+  CHECK_FALSE(file.nameExists("bonds"));
+  const H5::Group frame = file.openGroup("frames/000000");
+  std::set<std::string> names;
+  for (hsize_t k = 0; k < frame.getNumObjs(); ++k) names.insert(frame.getObjnameByIdx(k));
+  CHECK(names == std::set<std::string>{"force", "id", "omega", "position", "radius", "velocity"});
+}
+
+TEST_CASE("output: bad bond datasets in a run file are refused with file, dataset and row",
+          "[output][bonds]") {
+  H5::Exception::dontPrint();
+  TempDir dir;
+  const fs::path path = dir / "run.h5";
+  Frame frame(3, 0.0, 0);
+  frame.bond_a = {0, 1};
+  frame.bond_b = {1, 2};
+  frame.bond_intact = {1, 1};
+  auto written = [&] {
+    output::RunFile run(path, kScene);
+    run.writeFrame(frame.snapshot());
+    run.close(false);
+  };
+  // Replaces one dataset of the good file by `values` (as a tool or a bad copy might).
+  auto replace = [&](const std::string& group, const char* name, const std::vector<std::uint32_t>& values) {
+    written();
+    H5::H5File file(path.string(), H5F_ACC_RDWR);
+    const H5::Group g = file.openGroup(group);
+    g.unlink(name);
+    const hsize_t n = values.size();
+    g.createDataSet(name, H5::PredType::NATIVE_UINT32, H5::DataSpace(1, &n))
+        .write(values.data(), H5::PredType::NATIVE_UINT32);
+  };
+  auto error = [&] {
+    try {
+      output::RunFileReader reader(path);
+      reader.frame(0);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  replace("bonds", "bond_b", {1, 7});
+  std::string e = error();
+  CHECK_THAT(e, Catch::Contains(path.string()) && Catch::Contains("dataset /bonds/bond_b row 1") &&
+                    Catch::Contains("ball 7 does not exist (the frame has 3 balls)"));
+  replace("bonds", "bond_a", {0});
+  e = error();
+  CHECK_THAT(e, Catch::Contains("dataset /bonds/bond_a row 1") && Catch::Contains("has 1 rows but bond_intact has 2"));
+  replace("bonds", "bond_a", {0, 2});
+  CHECK_THAT(error(), Catch::Contains("dataset /bonds/bond_b row 1: joins ball 2 to itself"));
+  replace("frames/000000", "bond_intact", {1, 1, 0});  // uint32 read as uint8: values kept, length 3
+  CHECK_THAT(error(), Catch::Contains("frame 0") && Catch::Contains("has 2 rows but bond_intact has 3"));
+  // The writer refuses such a snapshot before writing anything.
+  output::RunFile run(dir / "other.h5", kScene);
+  frame.bond_b = {1, 3};
+  CHECK_THROWS_WITH(run.writeFrame(frame.snapshot()), Catch::Contains("bond_b row 1: ball 3 does not exist"));
   CHECK(run.frameCount() == 0);
 }
 

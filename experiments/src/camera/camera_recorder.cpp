@@ -29,7 +29,7 @@ CameraRecorder::CameraRecorder(const CameraSettings& settings, const Scene& scen
                                const std::filesystem::path& out_dir, std::ostream& log)
     : settings_(settings),
       out_dir_(out_dir),
-      builder_(scene),
+      builder_(scene, settings.colour_by),
       renderer_(settings.camera, renderOptionsFor(settings)),
       next_still_(settings.start_time) {
   log << "  camera '" << settings_.name << "': " << settings_.camera.width << "x" << settings_.camera.height << " at "

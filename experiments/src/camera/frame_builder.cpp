@@ -1,16 +1,22 @@
 #include "camera/frame_builder.h"
 
+#include "camera/fragment_colours.h"
+#include "camera/plane_look.h"
 #include "rocklab/sim/wall_motion.h"
 
 namespace rocklab::experiments {
 
 using geometry::Vec3;
 
-FrameBuilder::FrameBuilder(const Scene& scene)
-    : looks_(scene.wall_looks), material_colours_(scene.material_colours) {
-  for (const sim::Wall& w : scene.model.walls)
+FrameBuilder::FrameBuilder(const Scene& scene, ColourBy colour_by)
+    : looks_(scene.wall_looks), material_colours_(scene.material_colours), colour_by_(colour_by) {
+  for (std::size_t k = 0; k < scene.model.walls.size(); ++k) {
+    const sim::Wall& w = scene.model.walls[k];
+    const bool slab = w.shape == sim::WallShape::Plane && k < looks_.size() && looks_[k].plane_thickness > 0;
     meshes_.push_back(w.shape == sim::WallShape::Mesh ? std::make_shared<const geometry::TriangleMesh>(w.mesh)
+                      : slab                          ? std::make_shared<const geometry::TriangleMesh>(planeSlab(looks_[k]))
                                                       : nullptr);
+  }
 }
 
 render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const sim::Model& model,
@@ -19,18 +25,22 @@ render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const si
   render::FrameDescription f;
   f.time = s.time;
   f.index = index;
-  f.spheres.reserve(s.position.size());
-  for (std::size_t i = 0; i < s.position.size(); ++i) {
+  const std::size_t n = s.position.size();
+  std::vector<render::Rgb> colour(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto m = static_cast<std::size_t>(s.material[i]);
+    colour[i] = m < material_colours_.size() ? material_colours_[m] : render::kGreyPebble;
+  }
+  if (colour_by_ == ColourBy::Fragment) colour = fragmentColours(s, colour);
+  f.spheres.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const bool member = !s.clump.empty() && s.clump[i] >= 0;
     const std::uint64_t body = member ? s.clump_id[static_cast<std::size_t>(s.clump[i])] : s.id[i];
     render::SphereInstance sphere;
     sphere.centre = s.position[i];
     sphere.radius = s.radius[i];
     sphere.velocity = s.velocity[i];
-    const auto m = static_cast<std::size_t>(s.material[i]);
-    sphere.colour = marker_bodies.count(body) ? render::kRedMarker
-                    : m < material_colours_.size() ? material_colours_[m]
-                                                   : render::kGreyPebble;
+    sphere.colour = marker_bodies.count(body) ? render::kRedMarker : colour[i];
     f.spheres.push_back(sphere);
   }
   for (std::size_t k = 0; k < model.walls.size() && k < looks_.size(); ++k) {
@@ -38,31 +48,29 @@ render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const si
     const WallLook& look = looks_[k];
     const bool active = k < s.wall_active.size() ? s.wall_active[k] != 0 : w.activeAt(s.time);
     if (!look.visible || !active) continue;
-    if (w.shape == sim::WallShape::Mesh) {
+    const sim::WallPose pose = sim::wallPoseAt(w.motion, s.time);
+    if (meshes_[k]) {
       render::MeshInstance mesh;
       mesh.mesh = meshes_[k];
       mesh.colour = look.colour;
       mesh.opacity = look.opacity;
-      // Rigid motion: rotation about the pivot plus translation (the renderer takes R x + t).
-      const sim::WallPose pose = sim::wallPoseAt(w.motion, s.time);
-      mesh.rotation = pose.rotation;
-      mesh.translation = pose.place(Vec3::Zero());
+      // Rigid motion: the renderer takes R x + t. A mesh wall is in world
+      // coordinates, a plane's slab in the plane's frame at its point.
+      const bool plane = w.shape == sim::WallShape::Plane;
+      mesh.rotation = plane ? geometry::Mat3(pose.rotation * planeFrame(w.normal)) : pose.rotation;
+      mesh.translation = pose.place(plane ? w.point : Vec3::Zero());
       f.meshes.push_back(mesh);
       continue;
     }
     render::Polygon poly;
     poly.colour = look.colour;
     poly.opacity = look.opacity;
-    const sim::WallPose pose = sim::wallPoseAt(w.motion, s.time);
     if (w.shape == sim::WallShape::Polygon) {
       for (const Vec3& v : w.vertices) poly.vertices.push_back(pose.place(v));
     } else {
-      // An infinite plane drawn as a square of plane_size around its point.
-      const Vec3 n = w.normal.normalized();
-      const Vec3 a = n.unitOrthogonal(), b = n.cross(a);
-      const double h = 0.5 * look.plane_size;
-      const Vec3 c = pose.place(w.point);
-      poly.vertices = {c - h * a - h * b, c + h * a - h * b, c + h * a + h * b, c - h * a + h * b};
+      // An infinite plane: its outline (a square or a disc) around its point.
+      const geometry::Mat3 frame = planeFrame(w.normal);
+      for (const Vec3& v : planeOutline(look)) poly.vertices.push_back(pose.place(w.point + frame * v));
     }
     f.polygons.push_back(poly);
   }

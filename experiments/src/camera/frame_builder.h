@@ -1,8 +1,9 @@
 #pragma once
 // A simulation snapshot as the renderer's frame description: every ball a
-// sphere (marker bodies red, the others in their material's colour), every
-// active wall a polygon, a square (infinite planes) or a mesh, in its pose at
-// the snapshot's time. The renderer never sees sim types.
+// sphere (marker bodies red, the others in their material's colour, or by
+// fragment: camera/fragment_colours.h), every active wall a polygon, a mesh,
+// or for an infinite plane its look (camera/plane_look.h: square or disc, flat
+// or a slab), in its pose at the snapshot's time. The renderer never sees sim types.
 #include <cstdint>
 #include <memory>
 #include <unordered_set>
@@ -16,7 +17,7 @@ namespace rocklab::experiments {
 
 class FrameBuilder {
  public:
-  explicit FrameBuilder(const Scene& scene);
+  explicit FrameBuilder(const Scene& scene, ColourBy colour_by = ColourBy::Material);
   /// `model` is the world's current model (walls may have been switched on or off).
   render::FrameDescription describe(const sim::Snapshot& s, const sim::Model& model,
                                     const std::unordered_set<std::uint64_t>& marker_bodies,
@@ -25,7 +26,10 @@ class FrameBuilder {
  private:
   std::vector<WallLook> looks_;
   std::vector<render::Rgb> material_colours_;
-  std::vector<std::shared_ptr<const geometry::TriangleMesh>> meshes_;  // per wall (mesh walls only)
+  ColourBy colour_by_;
+  // Per wall: the mesh of a mesh wall, or the slab of a plane drawn with
+  // thickness (in the plane's frame); null for the others.
+  std::vector<std::shared_ptr<const geometry::TriangleMesh>> meshes_;
 };
 
 }  // namespace rocklab::experiments

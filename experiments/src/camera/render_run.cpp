@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "camera/camera_recorder.h"
+#include "camera/wall_placement.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/sim/output/run_file.h"
@@ -15,7 +16,7 @@ namespace rocklab::experiments {
 int renderRun(const RenderRunOptions& o, std::ostream& log) {
   try {
     sim::output::RunFileReader run(o.run_file);
-    const Scene scene = loadSceneText(run.sceneText(), o.run_file.string() + ":/scene", {}, o.run_file.parent_path());
+    Scene scene = loadSceneText(run.sceneText(), o.run_file.string() + ":/scene", {}, o.run_file.parent_path());
     std::vector<CameraSettings> cameras = o.camera_file.empty() ? scene.cameras : loadCameras(o.camera_file);
     if (cameras.empty()) {
       log << "error: " << o.run_file.string() << ": the stored scene has no [[cameras]]; give --camera CAMERA.toml\n";
@@ -25,13 +26,15 @@ int renderRun(const RenderRunOptions& o, std::ostream& log) {
       log << "error: " << o.run_file.string() << ": no frames stored (set output.frame_interval when running)\n";
       return kExitBadInput;
     }
-    // Markers: the ids the chute chose, from results.json beside the run.
+    // From results.json beside the run: the markers the chute chose, and where
+    // the experiment placed the plane walls (the Zwick platens; its last placement).
     std::unordered_set<std::uint64_t> markers;
     std::ifstream results(o.run_file.parent_path() / "results.json");
     if (results) {
       const nlohmann::json r = nlohmann::json::parse(results, nullptr, false);
       if (r.is_object() && r.contains("markers"))
         for (const auto& m : r["markers"]) markers.insert(m["id"].get<std::uint64_t>());
+      if (r.is_object() && r.contains("wall_placement")) applyWallPlacement(r["wall_placement"], scene.model);
     }
     const std::filesystem::path out = o.out_dir.empty() ? o.run_file.parent_path() : o.out_dir;
     std::filesystem::create_directories(out);

@@ -8,6 +8,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "camera/wall_placement.h"
 #include "common/atomic_file.h"
 #include "run/run_internal.h"
 
@@ -101,6 +102,7 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["clumps"] = world.particles().clumps.size();
   if (!scene.clump_shapes.empty()) r["clump_shapes"] = clumpShapesJson(scene.clump_shapes);
   r["walls"] = world.model().walls.size();
+  r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
   r["threads"] = world.threads();
   r["modules"] = setup.modules;
   r["seed"] = scene.run.seed;

@@ -59,6 +59,9 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     c.motion_blur = t.boolean("motion_blur", c.motion_blur);
     c.noise_sigma = t.number("noise_sigma", c.noise_sigma, Range::closed(0, 100));
     c.light_gain = t.number("light_gain", c.light_gain, Range::closed(0, 10));
+    c.colour_by = t.string("colour_by", "material", {"material", "fragment"}) == "fragment"
+                      ? ColourBy::Fragment
+                      : ColourBy::Material;
     if (c.motion_blur && !(cam.exposureTime > 0)) t.fail("motion_blur", "needs exposure > 0 s");
     t.finish();
     cameras.push_back(c);

@@ -10,14 +10,16 @@ namespace rocklab::experiments::detail {
 
 namespace {
 
-/// How a wall is drawn: colour, opacity, visible, plane_size (keys of
-/// [[walls]]).
+/// How a wall is drawn: colour, opacity, visible, and for an infinite plane
+/// plane_size, plane_shape, plane_thickness (keys of [[walls]]).
 WallLook readWallLook(TableReader& t) {
   WallLook look;
   look.colour = readColour(t, "colour", look.colour);
   look.opacity = static_cast<float>(t.number("opacity", look.opacity, Range::closed(0, 1)));
   look.visible = t.boolean("visible", look.visible);
   look.plane_size = t.number("plane_size", look.plane_size, Range::positive());
+  look.plane_disc = t.string("plane_shape", "square", {"square", "disc"}) == "disc";
+  look.plane_thickness = t.number("plane_thickness", look.plane_thickness, Range::nonNegative());
   return look;
 }
 

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <span>
 #include <stdexcept>
 #include <system_error>
@@ -63,9 +64,41 @@ bool framed(FrameWrite rule, bool empty, bool no_clumps) {
     case FrameWrite::WithClumps:
       return !no_clumps;
     case FrameWrite::Never:
+    case FrameWrite::PerFile:  // writeOncePerFile
       return false;
   }
   return false;
+}
+
+/// Every Snapshot array as owned storage (arrays a frame never holds stay empty).
+struct SnapshotArrays {
+#define ROCKLAB_STORAGE(type, name, index, unit, frame, meaning) std::vector<type> name;
+  ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_STORAGE)
+#undef ROCKLAB_STORAGE
+};
+
+constexpr const char* kPerFileGroup = "bonds";
+
+/// A PerFile array (FrameWrite): the first non-empty values go to /bonds/<name>;
+/// a later frame whose values differ from those (balls removed and the bonds
+/// renumbered) carries its own copy. `written` holds what /bonds has.
+template <class T>
+void writeOncePerFile(const H5::H5File& file, const H5::Group& frame, const char* name,
+                      std::span<const T> values, const char* unit, std::vector<T>& written) {
+  if (values.empty()) return;
+  if (written.empty()) {
+    const H5::Group group = file.nameExists(kPerFileGroup) ? file.openGroup(kPerFileGroup)
+                                                           : file.createGroup(kPerFileGroup);
+    writeArray(group, name, values, unit);
+    written.assign(values.begin(), values.end());
+  } else if (values.size() != written.size() ||
+             std::memcmp(values.data(), written.data(), values.size() * sizeof(T)) != 0) {  // bitwise
+    writeArray(frame, name, values, unit);
+  }
+}
+
+std::string bondProblemText(const detail::BondProblem& p) {
+  return std::string(p.array) + " row " + std::to_string(p.row) + ": " + p.what;
 }
 
 std::string frameGroupName(std::size_t frame) {
@@ -112,6 +145,7 @@ struct RunFile::Impl {
   std::filesystem::path partial;  // `<path>.partial`, written while the run goes on
   H5::H5File file;
   H5::DataSet energy;
+  SnapshotArrays per_file;  // what /bonds holds (PerFile arrays), empty until written
   hsize_t energy_rows = 0;
   std::size_t frames = 0;
   bool open = true;
@@ -136,13 +170,17 @@ RunFile::~RunFile() {
 
 void RunFile::writeFrame(const Snapshot& snapshot) {
   impl_->requireOpen("writeFrame");
-  particleCount(snapshot);  // checks the arrays before anything is written
+  // The arrays are checked before anything is written.
+  if (const auto bad = detail::bondProblem(snapshot, particleCount(snapshot)))
+    throw std::invalid_argument("snapshot: " + bondProblemText(*bad));
   guarded(impl_->partial, "write a frame", [&] {
     const H5::Group frame = impl_->file.createGroup(frameGroupName(impl_->frames));
     writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
     writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
-#define ROCKLAB_WRITE(type, name, index, unit, frame_write, meaning)                     \
-  if (framed(FrameWrite::frame_write, snapshot.name.empty(), snapshot.clump_id.empty())) \
+#define ROCKLAB_WRITE(type, name, index, unit, frame_write, meaning)                          \
+  if (FrameWrite::frame_write == FrameWrite::PerFile)                                         \
+    writeOncePerFile(impl_->file, frame, #name, snapshot.name, unit, impl_->per_file.name);   \
+  else if (framed(FrameWrite::frame_write, snapshot.name.empty(), snapshot.clump_id.empty())) \
     writeArray(frame, #name, snapshot.name, unit);
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_WRITE)
 #undef ROCKLAB_WRITE
@@ -210,10 +248,8 @@ struct RunFileReader::Impl {
   H5::H5File file;
   std::string scene;
   std::vector<std::string> frame_names;
-  // Storage of the current frame (arrays a frame never holds stay empty).
-#define ROCKLAB_STORAGE(type, name, index, unit, frame, meaning) std::vector<type> name;
-  ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_STORAGE)
-#undef ROCKLAB_STORAGE
+  SnapshotArrays current;   // the current frame's arrays
+  SnapshotArrays per_file;  // /bonds: the PerFile arrays of the frames that do not carry their own
   Snapshot snapshot;
 };
 
@@ -232,8 +268,18 @@ RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::mak
     const H5::Group frames = impl_->file.openGroup("frames");
     for (hsize_t k = 0; k < frames.getNumObjs(); ++k) impl_->frame_names.push_back(frames.getObjnameByIdx(k));
     std::sort(impl_->frame_names.begin(), impl_->frame_names.end());  // 000000, 000001, ...
+    if (impl_->file.nameExists(kPerFileGroup)) {
+      const H5::Group group = impl_->file.openGroup(kPerFileGroup);
+#define ROCKLAB_READ_PER_FILE(type, name, index, unit, frame, meaning) \
+  if (FrameWrite::frame == FrameWrite::PerFile) impl_->per_file.name = detail::readArray<type>(group, #name);
+      ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_READ_PER_FILE)
+#undef ROCKLAB_READ_PER_FILE
+    }
   } catch (const H5::Exception& e) {
     throw std::runtime_error(where + e.getDetailMsg());
+  } catch (const std::runtime_error& e) {
+    if (std::string(e.what()).starts_with(where)) throw;
+    throw std::runtime_error(where + e.what());  // a /bonds dataset of the wrong shape
   }
 }
 
@@ -244,26 +290,43 @@ std::size_t RunFileReader::frameCount() const { return impl_->frame_names.size()
 
 const Snapshot& RunFileReader::frame(std::size_t k) {
   Impl& m = *impl_;
+  SnapshotArrays& c = m.current;
   using detail::readArray;
   try {
-    const H5::Group g = m.file.openGroup("frames/" + m.frame_names.at(k));
+    const std::string group = "frames/" + m.frame_names.at(k);
+    const H5::Group g = m.file.openGroup(group);
     Snapshot& s = m.snapshot;
     s = Snapshot{};
     g.openAttribute("time").read(H5::PredType::NATIVE_DOUBLE, &s.time);
     g.openAttribute("step").read(H5::PredType::NATIVE_UINT64, &s.step);
+    // A PerFile array comes from the frame when it carries its own, else from
+    // /bonds, and only in a frame that holds bonds (bond_intact).
 #define ROCKLAB_READ(type, name, index, unit, frame, meaning) \
-  if (FrameWrite::frame != FrameWrite::Never) m.name = readArray<type>(g, #name);
+  if (FrameWrite::frame != FrameWrite::Never) c.name = readArray<type>(g, #name);
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_READ)
 #undef ROCKLAB_READ
-    if (m.material.empty()) m.material.assign(m.position.size(), 0);  // files from before materials were stored
-#define ROCKLAB_VIEW(type, name, index, unit, frame, meaning) s.name = m.name;
+#define ROCKLAB_FROM_FILE(type, name, index, unit, frame, meaning)                               \
+  if (FrameWrite::frame == FrameWrite::PerFile && c.name.empty() && !c.bond_intact.empty()) \
+    c.name = m.per_file.name;
+    ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_FROM_FILE)
+#undef ROCKLAB_FROM_FILE
+    if (c.material.empty()) c.material.assign(c.position.size(), 0);  // files from before materials were stored
+#define ROCKLAB_VIEW(type, name, index, unit, frame, meaning) s.name = c.name;
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_VIEW)
 #undef ROCKLAB_VIEW
-    detail::particleCount(s);
+    const std::size_t n = detail::particleCount(s);
+    if (const auto bad = detail::bondProblem(s, n)) {
+      // Name the dataset the rows came from: the frame's own or the file's /bonds.
+      const std::string per_file = std::string(kPerFileGroup) + "/" + bad->array;
+      const bool from_file = !g.nameExists(bad->array) && m.file.nameExists(kPerFileGroup) &&
+                             m.file.openGroup(kPerFileGroup).nameExists(bad->array);
+      const std::string dataset = from_file ? per_file : group + "/" + bad->array;
+      throw std::runtime_error("dataset /" + dataset + " row " + std::to_string(bad->row) + ": " + bad->what);
+    }
     return s;
   } catch (const H5::Exception& e) {
     throw std::runtime_error("run file '" + m.path.string() + "' frame " + std::to_string(k) + ": " + e.getDetailMsg());
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {  // a bad shape, length or bond row
     throw std::runtime_error("run file '" + m.path.string() + "' frame " + std::to_string(k) + ": " + e.what());
   }
 }

@@ -68,6 +68,9 @@ Snapshot World::Impl::snapshot(std::vector<Vec3>& total_force, std::vector<std::
   s.clump_orientation = k.orientation;
   s.clump_force = obs.clump_force;
   s.clump_id = k.id;
+  s.bond_intact = bonds.state.intact;  // all three empty without bonds
+  s.bond_a = bonds.state.a;
+  s.bond_b = bonds.state.b;
   for (std::uint8_t t : history.pair_touch) s.contacts += t;
   for (std::uint8_t t : history.wall_touch) s.wall_contacts += t;
   return s;

@@ -69,8 +69,13 @@ struct AgglomerateReport {
 
 /// A virtual camera of the scene ([[cameras]]): frames are rendered only at its
 /// frame times, never every step. A scene without cameras never creates a GL context.
+/// What a ball's colour shows: its material (marker pebbles red), or its
+/// fragment (the balls joined by intact bonds; camera/fragment_colours.h).
+enum class ColourBy { Material, Fragment };
+
 struct CameraSettings {
   std::string name;
+  ColourBy colour_by = ColourBy::Material;
   geometry::Camera camera;       // intrinsics, pose, frame rate, exposure
   double start_time = 0.0;       // s, first frame
   double end_time = std::numeric_limits<double>::infinity();  // s
@@ -92,7 +97,12 @@ struct WallLook {
   render::Rgb colour{0.45f, 0.45f, 0.47f};
   float opacity = 1.0f;          // < 1: transparent (the Perspex wall the lab filmed through)
   bool visible = true;
-  double plane_size = 2.0;       // m, side of the square drawn for an infinite plane
+  // An infinite plane is drawn as a square (side plane_size) or a disc
+  // (diameter plane_size) around its point; with plane_thickness > 0 as a solid
+  // slab of that thickness behind the plane (a platen seen edge-on from the side).
+  double plane_size = 2.0;       // m
+  bool plane_disc = false;       // plane_shape = "disc" (default "square")
+  double plane_thickness = 0.0;  // m, 0 = a flat polygon
 };
 
 struct Scene {

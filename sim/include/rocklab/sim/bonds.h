@@ -31,6 +31,7 @@
 // peak tensile stress of Eq 2-33 is then positive.
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -144,5 +145,9 @@ BondStress bondStress(const BondDisc& disc, double normal_force, const geometry:
 /// Returns one label per ball, 0, 1, 2, ... in the order of each fragment's
 /// lowest ball index; an unbonded ball is a fragment of its own.
 std::vector<std::uint32_t> bondedClusters(std::size_t ball_count, const BondState& bonds);
+/// The same from the bond arrays alone (a Snapshot's bond_a, bond_b, bond_intact).
+std::vector<std::uint32_t> bondedClusters(std::size_t ball_count, std::span<const std::uint32_t> a,
+                                          std::span<const std::uint32_t> b,
+                                          std::span<const std::uint8_t> intact);
 
 }  // namespace rocklab::sim

@@ -24,17 +24,20 @@ struct Energy {
 };
 
 /// What a Snapshot array is indexed by: balls [n] (clump members included),
-/// clumps [c] or walls.
-enum class SnapshotIndex { Ball, Clump, Wall };
+/// clumps [c], walls or parallel bonds [bonds] (WorldState::bonds, intact and broken).
+enum class SnapshotIndex { Ball, Clump, Wall, Bond };
 /// Whether a run.h5 frame (output/run_file.cpp) writes a Snapshot array: Always,
-/// IfAny (when not empty), WithClumps (when the snapshot has clumps) or Never.
-enum class FrameWrite { Always, IfAny, WithClumps, Never };
+/// IfAny (when not empty), WithClumps (when the snapshot has clumps), Never, or
+/// PerFile: once per file in /bonds (Bond arrays that change only when balls are
+/// removed and renumbered; a frame whose values differ carries its own copy).
+enum class FrameWrite { Always, IfAny, WithClumps, Never, PerFile };
 
 // The Snapshot's arrays, listed once: the struct, the run.h5 frame writer and
 // reader, and the size check (output/snapshot_check.h) expand this table.
 // X(type, name, index, unit, frame, meaning); index is a SnapshotIndex, frame a
-// FrameWrite. Clump arrays are all empty without clumps; member balls appear in
-// the ball arrays too. Where each gets its value: World::Impl::snapshot
+// FrameWrite. Clump arrays are all empty without clumps, bond arrays without
+// bonds (so such frames hold no bond datasets); member balls appear in the ball
+// arrays too. Where each gets its value: World::Impl::snapshot
 // (sim/src/stages/observe.cpp).
 #define ROCKLAB_SNAPSHOT_FIELDS(X)                                                      \
   X(geometry::Vec3, position, Ball, "m", Always, "at `time`")                           \
@@ -51,7 +54,10 @@ enum class FrameWrite { Always, IfAny, WithClumps, Never };
   X(geometry::Vec3, clump_omega, Clump, "rad/s", WithClumps, "synchronised to `time`")  \
   X(geometry::Quat, clump_orientation, Clump, "", WithClumps, "body -> world")          \
   X(geometry::Vec3, clump_force, Clump, "N", Never, "total including gravity")          \
-  X(std::uint64_t, clump_id, Clump, "", WithClumps, "stable id")
+  X(std::uint64_t, clump_id, Clump, "", WithClumps, "stable id")                        \
+  X(std::uint8_t, bond_intact, Bond, "", IfAny, "1 while bond k holds, then 0 for ever")  \
+  X(std::uint32_t, bond_a, Bond, "", PerFile, "first ball of bond k (index)")             \
+  X(std::uint32_t, bond_b, Bond, "", PerFile, "second ball of bond k (index)")
 
 #define ROCKLAB_SNAPSHOT_SPAN(type, name, index, unit, frame, meaning) std::span<const type> name;
 

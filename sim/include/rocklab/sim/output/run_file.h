@@ -12,6 +12,11 @@
 //                          with clumps also: clump [n] int32 (owning clump, -1 free),
 //                          clump_position [c,3] m, clump_velocity [c,3] m/s, clump_omega [c,3]
 //                          rad/s, clump_orientation [c,4] (x, y, z, w; body -> world), clump_id [c]
+//                          with parallel bonds also: bond_intact [bonds] uint8 (1 while bond k
+//                          holds); bond_a, bond_b [bonds] uint32 only when they differ from
+//                          /bonds (balls removed and renumbered during the run)
+//   /bonds                 once per file, with parallel bonds: bond_a, bond_b [bonds] uint32,
+//                          the balls (indices into a frame's ball arrays) bond k joins
 //   /energy                [rows, 8] double, extendible and chunked; columns (attr "columns"):
 //                          time s, step, kinetic_translational J, kinetic_rotational J,
 //                          potential_gravity J, elastic J, total J, contacts
@@ -58,6 +63,8 @@ class RunFileReader {
   const std::string& sceneText() const;
   std::size_t frameCount() const;
   /// Frame k as a snapshot (energy not included); valid until the next call.
+  /// Throws std::runtime_error naming the file, the frame, and for a bad bond
+  /// row the dataset and row (a wrong length, a missing ball, a self-bond).
   const Snapshot& frame(std::size_t k);
 
  private:
