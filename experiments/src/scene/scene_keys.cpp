@@ -119,7 +119,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"walls", "colour", "", "Colour [r, g, b] in images.", "[r, g, b], each in [0, 1]", "[0.45, 0.45, 0.47]"},
       {"walls", "opacity", "", "Opacity in images; < 1 is transparent (the Perspex the lab filmed through)."},
       {"walls", "visible", "", "Draw the wall in images."},
-      {"walls", "plane_size", "m", "Side of the square drawn for an infinite plane."},
+      {"walls", "plane_size", "m", "Side (square) or diameter (disc) of the shape drawn for an infinite plane."},
+      {"walls", "plane_shape", "", "How an infinite plane is drawn around its point: a square or a disc."},
+      {"walls", "plane_thickness", "m", "Draw the plane as a solid slab of this thickness behind it (a platen seen edge-on); 0 = flat."},
       {"walls.motion", "", "", "x(t) = pivot + velocity t + amplitude sin(2 pi frequency t) + R(angular_velocity t) (x0 - pivot)."},
       {"walls.motion", "velocity", "m/s", "Constant translation velocity."},
       {"walls.motion", "angular_velocity", "rad/s", "Constant angular velocity about the pivot (not for infinite planes)."},
@@ -173,6 +175,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
 
       // --- [bonds]
       {"bonds", "", "", "The parallel-bond model (Eq 2-27 to 2-38) and the strengths of the agglomerates' bonds."},
+      {"bonds", "type", "", "Parallel bonds (§8.2), contact bonds (§8.1), or both on every bonded pair."},
+      {"bonds", "contact_normal_strength", "N", "(contact) Tensile strength F_c^n of a contact bond, a force.", nullptr, "required (contact)"},
+      {"bonds", "contact_shear_strength", "N", "(contact) Shear strength F_c^s of a contact bond, a force.", nullptr, "contact_normal_strength"},
       {"bonds", "radius_multiplier", "", "phi of Eq 2-35: bond radius = phi x the smaller ball radius."},
       {"bonds", "normal_stiffness", "Pa/m", "Normal stiffness per unit area (the study's \"N/m\" read as N/m^3)."},
       {"bonds", "shear_stiffness", "Pa/m", "Shear stiffness per unit area."},
@@ -206,6 +211,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"cameras", "all_frames", "", "Write every frame as PNG to frames/NAME/ (what the tracker reads)."},
       {"cameras", "timestamp", "", "Time overlay on movie and stills."},
       {"cameras", "scale_bar", "", "Scale bar on movie and stills."},
+      {"cameras", "colour_by", "", "Ball colours: by material, or by fragment (balls joined by intact bonds share a colour; the largest keeps the material's)."},
       {"cameras", "scale_depth", "m", "Depth along the view at which the scale bar is true.", nullptr, "distance eye-target"},
       {"cameras", "motion_blur", "", "Average sub-frames over the exposure (needs exposure > 0)."},
       {"cameras", "noise_sigma", "", "Gaussian image noise, in grey levels."},
@@ -464,6 +470,9 @@ shear_modulus = 1e9
 [contact]
 law = "hertz_mindlin"
 [bonds]
+type = "parallel+contact"
+contact_normal_strength = 10
+contact_shear_strength = 5
 radius_multiplier = 1
 normal_stiffness = 1e12
 shear_stiffness = 1e12
