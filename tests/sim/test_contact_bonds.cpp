@@ -252,17 +252,8 @@ struct GluedRows {
 TEST_CASE("contact bond: bitwise the same on one and two threads while contact bonds break",
           "[bonds]") {
   const GluedRows scene(60, 100);  // 6000 balls: two threads need > 5000
-  auto run = [&](int threads) {
-    sim::World world(scene.model, scene.spheres, {}, scene.bonds, threads);
-    for (int s = 0; s < 400; ++s)
-      world.step(s % 50 == 0 ? [](const sim::Snapshot&) {}
-                             : std::function<void(const sim::Snapshot&)>{});
-    std::vector<std::uint32_t> broken;
-    for (const sim::BondBreak& e : world.bondBreaks()) broken.push_back(e.bond);
-    return std::tuple{world.stateHash(), broken, world.threads()};
-  };
-  const auto [one, broken_one, t1] = run(1);
-  const auto [two, broken_two, t2] = run(2);
+  const auto [one, broken_one, t1] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
+  const auto [two, broken_two, t2] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
   REQUIRE(t1 == 1);
   if (t2 < 2)
     WARN("this machine gives the world one thread only; the two-thread half is not exercised");

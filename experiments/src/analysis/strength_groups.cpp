@@ -24,6 +24,14 @@ std::string text(double v) {
   return s.str();
 }
 
+/// The mean of the values; NaN for none.
+double meanOf(const std::vector<double>& v) {
+  if (v.empty()) return NAN;
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum / static_cast<double>(v.size());
+}
+
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
@@ -89,16 +97,12 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
   for (const Group& g : groups) {
     nlohmann::json row{{"value", g.value}, {"runs", g.strengths.size()}};
     std::vector<std::string> cells{g.value, std::to_string(g.strengths.size())};
-    double mean = NAN, sd = NAN;
-    if (!g.strengths.empty()) {
-      mean = 0;
-      for (double s : g.strengths) mean += s;
-      mean /= static_cast<double>(g.strengths.size());
-      if (g.strengths.size() > 1) {
-        double ss = 0;
-        for (double s : g.strengths) ss += (s - mean) * (s - mean);
-        sd = std::sqrt(ss / static_cast<double>(g.strengths.size() - 1));
-      }
+    const double mean = meanOf(g.strengths);
+    double sd = NAN;
+    if (g.strengths.size() > 1) {
+      double ss = 0;
+      for (double s : g.strengths) ss += (s - mean) * (s - mean);
+      sd = std::sqrt(ss / static_cast<double>(g.strengths.size() - 1));
     }
     row["mean_MPa"] = mean;
     row["stddev_MPa"] = sd;
@@ -115,12 +119,7 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
     }
     for (std::size_t k : extra) {
       const auto it = g.columns.find(k);
-      double m = NAN;
-      if (it != g.columns.end() && !it->second.empty()) {
-        m = 0;
-        for (double v : it->second) m += v;
-        m /= static_cast<double>(it->second.size());
-      }
+      const double m = it != g.columns.end() ? meanOf(it->second) : NAN;
       row["mean"][table.header[k]] = m;
       cells.push_back(std::isfinite(m) ? text(m) : "");
     }
@@ -141,9 +140,7 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
       if (!o.size_column.empty()) {
         const auto it = g.columns.find(size_col);
         if (it != g.columns.end() && !it->second.empty()) {
-          double d = 0;
-          for (double v : it->second) d += v;
-          d /= static_cast<double>(it->second.size());
+          const double d = meanOf(it->second);
           sizes.push_back(endsWith(o.size_column, "_m") ? d * 1e3 : d);
           mean_strengths.push_back(mean);
         }

@@ -27,16 +27,10 @@ const LabFraction kTableFiveOne[] = {
     {"40-60", 9.49, 8.47, 0.9882, 2.4398},
 };
 
-std::string number(double v) {
-  std::ostringstream s;
-  s << std::setprecision(6) << v;
-  return s.str();
-}
-
 /// The scene's assignments for bonds of one strength (Pa), normal = shear (§f.6 [I]).
 std::vector<std::string> constantStrength(double strength) {
-  return {"bonds.strength_distribution = \"constant\"", "bonds.tensile_strength = " + number(strength),
-          "bonds.shear_strength = " + number(strength)};
+  return {"bonds.strength_distribution = \"constant\"", "bonds.tensile_strength = " + detail::cell(strength),
+          "bonds.shear_strength = " + detail::cell(strength)};
 }
 
 double percentOff(double value, double target) { return 100.0 * (value - target) / target; }
@@ -122,8 +116,8 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
                       {"off_target_pct", percentOff(sigma, target_pa)},
                       {"next_bond_strength_Pa", next},
                       {"wall_time_s", wall}});
-    rows.push_back({std::to_string(k + 1), number(bond * 1e-6), number(sigma * 1e-6),
-                    number(percentOff(sigma, target_pa)), number(next * 1e-6), number(wall)});
+    rows.push_back({std::to_string(k + 1), detail::cell(bond * 1e-6), detail::cell(sigma * 1e-6),
+                    detail::cell(percentOff(sigma, target_pa)), detail::cell(next * 1e-6), detail::cell(wall)});
     calibrated = next;
     if (std::abs(percentOff(sigma, target_pa)) <= c.tolerance_pct) {
       calibrated = bond;  // this trial is on target: keep its B
@@ -139,7 +133,7 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
   batch.out_dir = dir / "batch";
   for (const std::string& s : constantStrength(calibrated)) batch.overrides.push_back(s);
   batch.overrides.push_back("bonds.strength_distribution = \"weibull_per_agglomerate\"");
-  batch.overrides.push_back("bonds.weibull_modulus = " + number(c.target.modulus));
+  batch.overrides.push_back("bonds.weibull_modulus = " + detail::cell(c.target.modulus));
   std::vector<std::string> seeds;
   for (int k = 0; k < c.count; ++k) seeds.push_back(std::to_string(c.first_seed + k));
   batch.vary = {{"scene.seed", seeds}};
