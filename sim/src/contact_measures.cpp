@@ -41,9 +41,14 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 /// Calls pair(i, j, point, force on i) for every touching ball pair and
 /// wall(i, wall, point, force on i) for every touching ball-wall contact, with
 /// the elastic contact force (normal spring at the overlap the law sees, and the
-/// shear spring; no dashpots) of the last step.
+/// shear spring of the last step; no dashpots) of the state at the current time:
+/// the balls where the last step moved them, the walls where their motion puts
+/// them now (the stage-1 poses are a step old: a moving platen would read the
+/// overlap of a step ago).
 template <class Law, class PairVisit, class WallVisit>
 void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const {
+  std::vector<detail::WallRuntime> walls_now = walls;
+  for (std::size_t k = 0; k < walls_now.size(); ++k) walls_now[k].update(model.walls[k], time);
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
       if (!history.pair_touch[k]) continue;
@@ -61,7 +66,7 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       if (!history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
       ContactPoint touch;
-      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
+      if (!ballWallTouch(walls_now[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
       const double overlap = wallOverlap(touch, c);
       if (overlap <= 0) continue;
       double secant, tangent;

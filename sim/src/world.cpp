@@ -105,6 +105,7 @@ const ParticleState& World::particles() const { return impl_->p; }
 const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
 const WorldStats& World::stats() const { return impl_->stats; }
 int World::threads() const { return impl_->teamSize(); }
+int World::bondThreads() const { return impl_->bondTeamSize(); }
 Vec3 World::gravity() const { return impl_->gravity; }
 const BondState& World::bonds() const { return impl_->bonds.state; }
 std::size_t World::intactBonds() const { return impl_->bonds.intact; }

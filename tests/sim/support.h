@@ -21,18 +21,19 @@ inline sim::Model linearModel(double kn = 1e6, double friction = 0.0, double bet
 }
 
 /// What a run of `steps` steps on `threads` threads ended with, to compare runs
-/// with bonds breaking: the state hash, the bonds broken in order, the team used.
+/// with bonds breaking: the state hash, the bonds broken in order, the teams used.
 struct BreakingRun {
   std::uint64_t hash = 0;
   std::vector<std::uint32_t> broken;
   int threads = 0;
+  int bond_threads = 0;
 };
 inline BreakingRun runWithBreaks(const sim::Model& model, const std::vector<sim::SphereSpec>& spheres,
                                  const std::vector<sim::BondSpec>& bonds, int threads, int steps = 400) {
   sim::World world(model, spheres, {}, bonds, threads);
   for (int s = 0; s < steps; ++s)  // every 50th step observed, as outputs would
     world.step(s % 50 == 0 ? [](const sim::Snapshot&) {} : std::function<void(const sim::Snapshot&)>{});
-  BreakingRun r{world.stateHash(), {}, world.threads()};
+  BreakingRun r{world.stateHash(), {}, world.threads(), world.bondThreads()};
   for (const sim::BondBreak& e : world.bondBreaks()) r.broken.push_back(e.bond);
   return r;
 }

@@ -362,8 +362,10 @@ struct BreakingRows {
 
 TEST_CASE("bond: bitwise the same on one and two threads while bonds break", "[bonds]") {
   const BreakingRows scene(60, 100);  // 6000 balls: two threads need > 5000
-  const auto [one, broken_one, t1] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
-  const auto [two, broken_two, t2] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
+  const auto [one, broken_one, t1, b1] =
+      test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
+  const auto [two, broken_two, t2, b2] =
+      test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
   REQUIRE(t1 == 1);
   if (t2 < 2)
     WARN("this machine gives the world one thread only; the two-thread half is not exercised");
@@ -371,6 +373,21 @@ TEST_CASE("bond: bitwise the same on one and two threads while bonds break", "[b
   CHECK(broken_one == broken_two);
   CHECK(broken_one.size() > 10);                  // bonds did break
   CHECK(broken_one.size() < scene.bonds.size());  // and others held
+}
+
+TEST_CASE("bond: a world too small for two threads runs its many bonds on two, bitwise the same",
+          "[bonds]") {
+  // 4,500 balls (one thread: fewer than 5,000) and 4,455 bonds (two: 2,000 a thread).
+  const BreakingRows scene(45, 100);
+  const auto one = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
+  const auto two = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
+  REQUIRE(one.bond_threads == 1);
+  CHECK(two.threads == 1);
+  if (two.bond_threads < 2)
+    WARN("this machine gives the bond stage one thread only; the two-thread half is not exercised");
+  CHECK(one.hash == two.hash);
+  CHECK(one.broken == two.broken);
+  CHECK(one.broken.size() > 10);
 }
 
 TEST_CASE("bond: restart from a checkpoint with broken bonds equals the uninterrupted run",

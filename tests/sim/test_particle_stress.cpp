@@ -37,6 +37,34 @@ TEST_CASE("particle stress: a sphere between two platens gives q = (2 sqrt 2 / p
         1e-9);  // the least compressive direction is in the xy plane
 }
 
+TEST_CASE("wall load: a moving platen's load is read where the platen is now, not a step ago",
+          "[stress][walls]") {
+  // A ball too heavy to move; a plane closing on it at v. Its load after a step
+  // is the series spring kn / 2 (Eq 2-20) times the overlap at the current time,
+  // v t - gap. Read against the platen's pose of the step before, it would be
+  // short by kn / 2 v dt, which the bound is a thousandth of.
+  const double r = 0.01, gap = 1e-6, v = 0.05, kn = 1e6;
+  sim::Model model = test::linearModel(kn);
+  model.materials[0].density = 1e15;
+  model.timestep.dt = 1e-6;  // s: the heavy ball alone would allow seconds
+  sim::Wall top = test::plane("top", Vec3(0, 0, r + gap), -Vec3::UnitZ());
+  top.motion.velocity = Vec3(0, 0, -v);
+  model.walls = {top};
+  sim::World world(model, {test::sphere(Vec3::Zero(), r)}, 1);
+  const double dt = world.dt();
+  int loaded = 0;
+  while (world.time() < 4 * gap / v) {
+    world.step();
+    const double overlap = v * world.time() - gap;
+    if (overlap <= v * dt) continue;  // the contact appears at the next force pass
+    const double load = world.wallForces()[0].z();
+    CHECK(std::abs(load - 0.5 * kn * overlap) < 1e-3 * 0.5 * kn * v * dt);
+    ++loaded;
+  }
+  CHECK(loaded > 10);
+  CHECK(world.particles().position[0].norm() < 1e-12);  // the ball did not move
+}
+
 TEST_CASE("particle stress: equal principal stresses give q = 0; q is invariant under rotation",
           "[stress]") {
   const sim::PrincipalStresses iso = sim::principalStresses(Mat3::Identity() * 5e6);

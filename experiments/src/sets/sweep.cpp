@@ -33,8 +33,8 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   if (type == "heap") m = {"angle_of_repose_deg", "heap.settled"};
   if (type == "chute") m = {"clearance_time_s", "jammed", "chute.bodies"};
   if (type == "zwick")
-    m = {"strength_MPa", "peak_force_N", "zwick.platen_gap_at_peak_m", "bonds_broken", "sphere_count",
-         "bond_count", "porosity", "coordination_number"};
+    m = {"strength_MPa", "peak_force_N", "zwick.platen_gap_at_peak_m", "zwick.load_imbalance_loading",
+         "bonds_broken", "sphere_count", "bond_count", "porosity", "coordination_number"};
   m.push_back("simulated_time_s");
   m.push_back("wall_time_s.total");
   return m;

@@ -46,30 +46,39 @@ BondStress bondStress(const BondDisc& d, double normal_force, const Vec3& shear_
 
 namespace {
 
-/// v (in the plane normal to n_old) carried to the plane normal to n, by the
-/// rotation taking n_old to n (Rodrigues with the unnormalised axis
-/// k = n_old x n, |k| = sin, so k (k.v) (1 - cos) / sin^2 = k (k.v) / (1 + cos)).
-inline Vec3 tiltWith(const Vec3& v, const Vec3& n_old, const Vec3& n) {
-  const Vec3 k = n_old.cross(n);
-  const double c = n_old.dot(n);
-  if (c <= -1.0 + 1e-12) return v;  // turned over in one step: no defined rotation
-  return c * v + k.cross(v) + k * (k.dot(v) / (1.0 + c));
-}
+/// How a bond's contact plane turned in one step: tilted from the normal n_old
+/// to n, and spun about n by the mean of the balls' spins. Computed once per
+/// bond and applied to its shear force and its bending moment.
+struct PlaneTurn {
+  Vec3 n, k;   // k = n_old x n, |k| = sin of the tilt
+  double c;    // cos of the tilt
+  bool tilts;  // false when the normal turned over in one step (no defined rotation)
+  double sin_spin, cos_spin;
 
-/// v (in the plane normal to n) turned about n by `angle`; the series is exact to
-/// round-off for the tiny angles of one step and saves two trigonometric calls.
-inline Vec3 twistAbout(const Vec3& v, const Vec3& n, double angle) {
-  double s, c;
-  if (std::abs(angle) < 1e-3) {
-    const double a2 = angle * angle;
-    s = angle * (1.0 - a2 / 6.0);
-    c = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
-  } else {
-    s = std::sin(angle);
-    c = std::cos(angle);
+  PlaneTurn(const Vec3& n_old, const Vec3& n_new, double spin) : n(n_new), k(n_old.cross(n_new)) {
+    c = n_old.dot(n_new);
+    tilts = c > -1.0 + 1e-12;
+    // The series is exact to round-off for the tiny angles of one step and
+    // saves two trigonometric calls.
+    if (std::abs(spin) < 1e-3) {
+      const double a2 = spin * spin;
+      sin_spin = spin * (1.0 - a2 / 6.0);
+      cos_spin = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
+    } else {
+      sin_spin = std::sin(spin);
+      cos_spin = std::cos(spin);
+    }
   }
-  return c * v + s * n.cross(v);
-}
+
+  /// v (in the old plane) carried into the new one: the tilt by Rodrigues with
+  /// the unnormalised axis k (k (k.v) (1 - cos) / sin^2 = k (k.v) / (1 + cos)),
+  /// then the spin about n, then any round-off drift out of the plane removed.
+  [[gnu::always_inline]] Vec3 carry(const Vec3& v) const {
+    const Vec3 tilted = tilts ? Vec3(c * v + k.cross(v) + k * (k.dot(v) / (1.0 + c))) : v;
+    const Vec3 r = cos_spin * tilted + sin_spin * n.cross(tilted);
+    return r - r.dot(n) * n;
+  }
+};
 
 // The step checks merged across threads (mergeChecks: max and or, any order).
 #pragma omp declare reduction(mergeStepChecks : StepChecks : mergeChecks(omp_out, omp_in)) \
@@ -94,8 +103,10 @@ void World::Impl::bondStage(StepChecks& checks) {
   constexpr auto kContact = static_cast<std::uint8_t>(BondKind::Contact);
   bool any_broke = false;
   StepChecks bonded;  // the overlaps of contact-bonded pairs
-#pragma omp parallel for schedule(static) num_threads(teamSize()) reduction(|| : any_broke) \
-    reduction(mergeStepChecks : bonded)
+#pragma omp parallel for schedule(static) num_threads(bondTeamSize()) reduction(||           \
+                                                                                : any_broke) \
+    reduction(mergeStepChecks                                                                \
+              : bonded)
   for (std::ptrdiff_t kk = 0; kk < nbonds; ++kk) {
     const auto k = static_cast<std::size_t>(kk);
     bonds.broke[k] = 0;
@@ -118,11 +129,7 @@ void World::Impl::bondStage(StepChecks& checks) {
     const Vec3 xc = bondPoint(xa, p.radius[a], p.radius[b], n, dist);
     // Stored shear force and bending moment turn with the contact plane: its
     // tilt (n_old -> n) and its spin about n, the mean of the balls' spins.
-    const double spin = 0.5 * (p.omega[a] + p.omega[b]).dot(n) * h;
-    auto carry = [&](const Vec3& v) {
-      Vec3 r = twistAbout(tiltWith(v, n_old, n), n, spin);
-      return Vec3(r - r.dot(n) * n);  // no round-off drift out of the plane
-    };
+    const PlaneTurn turn(n_old, n, 0.5 * (p.omega[a] + p.omega[b]).dot(n) * h);
     // Increments (Eq 2-29..2-32): relative motion of b against a at the bond.
     const Vec3 v_rel =
         (p.velocity[b] + p.omega[b].cross(xc - xb)) - (p.velocity[a] + p.omega[a].cross(xc - xa));
@@ -133,9 +140,9 @@ void World::Impl::bondStage(StepChecks& checks) {
     const Vec3 dtheta_s = dtheta - dtheta_n * n;
     const BondDisc disc = bondDisc(s.radius[k]);
     const double fn = s.normal_force[k] - kn * disc.area * du_n;               // Eq 2-29
-    const Vec3 fs = carry(s.shear_force[k]) - (ks * disc.area) * du_s;         // Eq 2-30 [R]
+    const Vec3 fs = turn.carry(s.shear_force[k]) - (ks * disc.area) * du_s;    // Eq 2-30 [R]
     const double mn = s.twist_moment[k] - ks * disc.polar * dtheta_n;          // Eq 2-31 [R]
-    const Vec3 ms = carry(s.bend_moment[k]) - (kn * disc.inertia) * dtheta_s;  // Eq 2-32
+    const Vec3 ms = turn.carry(s.bend_moment[k]) - (kn * disc.inertia) * dtheta_s;  // Eq 2-32
     s.normal[k] = n;
     s.normal_force[k] = fn;
     s.shear_force[k] = fs;
@@ -203,7 +210,7 @@ void World::Impl::bondStage(StepChecks& checks) {
     }
   }
   const auto n = static_cast<std::ptrdiff_t>(p.size());
-#pragma omp parallel for schedule(static) num_threads(teamSize())
+#pragma omp parallel for schedule(static) num_threads(bondTeamSize())
   for (std::ptrdiff_t ii = 0; ii < n; ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     for (std::uint32_t e = bonds.ball_offset[i]; e < bonds.ball_offset[i + 1]; ++e) {

@@ -123,6 +123,8 @@ class World {
   const WorldStats& stats() const;
   /// Threads the step really uses: the requested ones, fewer for small worlds.
   int threads() const;
+  /// Threads the bond stage uses: as many as threads(), more for many bonds.
+  int bondThreads() const;
   Vec3 gravity() const;
   /// Every bond, intact and broken, as of the last step.
   const BondState& bonds() const;
