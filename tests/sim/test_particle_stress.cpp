@@ -37,7 +37,7 @@ TEST_CASE("particle stress: a sphere between two platens gives q = (2 sqrt 2 / p
         1e-9);  // the least compressive direction is in the xy plane
 }
 
-TEST_CASE("particle stress: equal principal stresses give q = 0; q is invariant under rotation",
+TEST_CASE("particle stress: equal principal stresses give q = 0 - q is invariant under rotation",
           "[stress]") {
   const sim::PrincipalStresses iso = sim::principalStresses(Mat3::Identity() * 5e6);
   CHECK(sim::octahedralShearStress(iso) == Approx(0.0).margin(1e-6));
