@@ -156,7 +156,11 @@ TEST_CASE("rocklab shape works on every mesh in assets/meshes", "[shape]") {
     CHECK(r["checks"]["warnings"].empty());  // generated meshes are clean
     CHECK(r["mesh"]["equivalent_diameter_m"].get<double>() == Approx(0.02).epsilon(0.001));
     CHECK(r["volume_error"].get<double>() <= 0.0);  // inscribed spheres
-    CHECK(r["volume_error"].get<double>() > -0.8);
+    // 8 inscribed spheres measured -9.1 to -21.8 % on the pebbles and the crushed
+    // rock and -57.7 % on the flake (deterministic): each held to about 5 points
+    // below its class's worst, so a lost sphere (a -30 % step at 8) fails.
+    const bool flake = e.path().filename().string().starts_with("flake");
+    CHECK(r["volume_error"].get<double>() > (flake ? -0.63 : -0.27));
   }
   CHECK(meshes >= 3);
 }
