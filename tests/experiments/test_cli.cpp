@@ -1,5 +1,7 @@
 // The CLI in-process: exit codes, outputs, and "bad input loses nothing".
 #include <H5Cpp.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -7,16 +9,20 @@
 #include <thread>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
+#include "rocklab/sim/output/checkpoint.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 using rocklab::experiments::test::cli;
 fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name);
+  // The pid keeps two checkouts' suites running at once apart.
+  const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
 }
@@ -55,8 +61,17 @@ TEST_CASE("a short run writes run.h5 - checkpoint - vtk and results.json", "[cli
                "scene.end_time=0.003"}) == 0);
   const auto r2 = nlohmann::json::parse(slurp(out2 / "results.json"));
   CHECK(r2["simulated_time_s"].get<double>() == Approx(0.003).margin(2e-6));
+  // ...bit for bit: the same state as a run straight to 0.003 s.
+  const fs::path out3 = tempDir("straight");
+  REQUIRE(cli({"run", kScene, "--out", out3.string(), "--quiet", "--set", "scene.end_time=0.003", "--set",
+               "particles.0.count=200", "--set", "output.frame_interval=0.001"}) == 0);
+  const auto r3 = nlohmann::json::parse(slurp(out3 / "results.json"));
+  CHECK(r2["steps"] == r3["steps"]);
+  CHECK(r2["state_hash"].get<std::string>() == r3["state_hash"].get<std::string>());
+  CHECK(r["state_hash"].get<std::string>() != r3["state_hash"].get<std::string>());  // the hash sees the motion
   fs::remove_all(out);
   fs::remove_all(out2);
+  fs::remove_all(out3);
 }
 
 TEST_CASE("bad input: exit code 2 and the previous outputs are untouched", "[cli]") {
@@ -95,8 +110,65 @@ TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and r
   int interrupted = 0;
   file.openAttribute("interrupted").read(H5::PredType::NATIVE_INT, &interrupted);
   CHECK(interrupted == 1);
-  CHECK(fs::exists(out / "checkpoint.h5"));
   file.close();
+  // The checkpoint holds the state the run stopped in, and a restart goes on from it.
+  const auto cp = rocklab::sim::output::readCheckpoint(out / "checkpoint.h5");
+  CHECK(cp.state.time == r["simulated_time_s"].get<double>());
+  CHECK(cp.state.step == r["steps"].get<std::uint64_t>());
+  const double more = cp.state.time + 0.001;
+  const fs::path out2 = tempDir("sigint-restart");
+  REQUIRE(cli({"restart", (out / "checkpoint.h5").string(), "--out", out2.string(), "--quiet", "--set",
+               "scene.end_time=" + std::to_string(more)}) == 0);
+  const auto r2 = nlohmann::json::parse(slurp(out2 / "results.json"));
+  CHECK(r2["status"] == "completed");
+  CHECK(r2["steps"].get<std::uint64_t>() > cp.state.step);
+  CHECK(r2["simulated_time_s"].get<double>() == Approx(more).margin(2e-6));
+  fs::remove_all(out);
+  fs::remove_all(out2);
+}
+
+TEST_CASE("a second Ctrl-C ends the process at once", "[cli]") {
+  // In a child process (the test's own would die): a run on one thread (no
+  // OpenMP team is forked) is interrupted twice in a row. raise() runs the
+  // handler in the raising thread before it returns, so the second signal comes
+  // after the first was handled and while the run is still stopping.
+  const fs::path out = tempDir("sigint2");
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    std::thread interrupter([] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(700));
+      std::raise(SIGINT);  // clean stop requested
+      std::raise(SIGINT);  // the second kills
+    });
+    const int code = cli({"run", kScene, "--out", out.string(), "--quiet", "--threads", "1", "--set",
+                          "scene.end_time=100"});
+    interrupter.join();
+    ::_exit(code == 130 ? 40 : 41);  // only reached when the second Ctrl-C did not kill
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  INFO("exit status " << (WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+  CHECK(WIFSIGNALED(status));
+  CHECK((WIFSIGNALED(status) && WTERMSIG(status) == SIGINT));
+  fs::remove_all(out);
+}
+
+TEST_CASE("restart refuses an experiment scene and writes nothing", "[cli]") {
+  // An experiment's phase is not in the checkpoint: continuing would run it from
+  // its first phase on a later state.
+  const fs::path out = tempDir("drop"), out2 = tempDir("drop-restart");
+  REQUIRE(cli({"run", "drop", "--out", out.string(), "--quiet", "--set", "scene.end_time=0.01", "--set",
+               "output.checkpoint=true"}) == 0);
+  REQUIRE(fs::exists(out / "checkpoint.h5"));
+  std::ostringstream log;
+  auto* const old = std::cerr.rdbuf(log.rdbuf());
+  const int code = cli({"restart", (out / "checkpoint.h5").string(), "--out", out2.string(), "--quiet", "--set",
+                        "scene.end_time=0.02"});
+  std::cerr.rdbuf(old);
+  CHECK(code == 2);
+  CHECK_THAT(log.str(), Catch::Contains("experiment.drop scenes cannot be restarted from a checkpoint"));
+  CHECK_FALSE(fs::exists(out2));
   fs::remove_all(out);
 }
 

@@ -1,6 +1,8 @@
 // `rocklab shape` in-process: outputs, the clump in a scene, bad input, real scans.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include <filesystem>
 #include <fstream>
@@ -154,7 +156,11 @@ TEST_CASE("rocklab shape works on every mesh in assets/meshes", "[shape]") {
     CHECK(r["checks"]["warnings"].empty());  // generated meshes are clean
     CHECK(r["mesh"]["equivalent_diameter_m"].get<double>() == Approx(0.02).epsilon(0.001));
     CHECK(r["volume_error"].get<double>() <= 0.0);  // inscribed spheres
-    CHECK(r["volume_error"].get<double>() > -0.8);
+    // 8 inscribed spheres measured -9.1 to -21.8 % on the pebbles and the crushed
+    // rock and -57.7 % on the flake (deterministic): each held to about 5 points
+    // below its class's worst, so a lost sphere (a -30 % step at 8) fails.
+    const bool flake = e.path().filename().string().starts_with("flake");
+    CHECK(r["volume_error"].get<double>() > (flake ? -0.63 : -0.27));
   }
   CHECK(meshes >= 3);
 }
@@ -164,10 +170,35 @@ TEST_CASE("the mesh-clump chute scene loads with the meshes' mass and inertia", 
                                                      "chute-30-mesh-clumps.toml");
   REQUIRE(scene.clumps.size() == 1680);
   REQUIRE(scene.clump_shapes.size() == 3);
+  // From each STL: the mesh taken to the scene's size, 19.9 mm equivalent diameter
+  // (the Eq 4-2 size of the four-ball clumps, scripts/make-shape-assets.sh), at the
+  // pebble density 2730 kg/m^3: mass rho pi d^3 / 6, principal moments those of
+  // the mesh in mm scaled by s^5 (s = 19.9 mm / its equivalent diameter).
+  // 1e-6: the scene file states them to 9 digits, the STL's floats to 7.
+  const double rho = 2730, d = 0.0199, mass = rho * std::numbers::pi * d * d * d / 6;
+  std::vector<rocklab::geometry::Vec3> moments;
+  for (int k = 1; k <= 3; ++k) {
+    const auto mesh = rocklab::geometry::readMeshFile(
+        (fs::path(ROCKLAB_SOURCE_DIR) / "assets" / "meshes" / ("pebble-" + std::to_string(k) + ".stl")).string(), 1e-3);
+    const auto props = rocklab::geometry::meshMassProperties(mesh, rho);
+    const double s = d / std::cbrt(6 * props.volume / std::numbers::pi);
+    CHECK(s == Approx(1.0).margin(0.01));  // the meshes are 20 mm ones
+    moments.push_back(props.principal_moments * std::pow(s, 5));
+    INFO("pebble-" << k);
+    CHECK(scene.clump_shapes[k - 1].mass == Approx(mass).epsilon(1e-6));
+    for (int a = 0; a < 3; ++a)
+      CHECK(scene.clump_shapes[k - 1].principal_inertia[a] == Approx(moments.back()[a]).epsilon(1e-6));
+  }
+  // Every clump carries its own shape's mass and moments, 560 of each.
+  int of_shape[3] = {0, 0, 0};
   for (const auto& c : scene.clumps) {
     CHECK(c.members.size() == 16);
-    CHECK(c.mass == Approx(0.0112647225));
+    CHECK(c.mass == Approx(mass).epsilon(1e-6));
+    for (int k = 0; k < 3; ++k) of_shape[k] += (c.principal_inertia - moments[k]).norm() < 1e-6 * moments[k].norm();
   }
+  CHECK(of_shape[0] == 560);
+  CHECK(of_shape[1] == 560);
+  CHECK(of_shape[2] == 560);
 }
 
 TEST_CASE("the clump frame is the mesh's principal frame and a scene keeps it", "[shape]") {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
+#include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/study.h"
 
 namespace fs = std::filesystem;
@@ -131,6 +132,20 @@ TEST_CASE("every built-in study file loads and names a scene that loads", "[stud
     CHECK_FALSE(o.figure.empty());
     CHECK_FALSE(o.runs.vary.empty());
     CHECK(findStudyFile(e.path().stem().string()));
+    // ...and its scene loads with the study's settings, at the cheapest and the
+    // finest value of every varied key (each run of the study is one of these
+    // corners or between them): a renamed key or a bad value fails here.
+    REQUIRE_FALSE(o.runs.scene.empty());
+    for (std::size_t end : {0, 1}) {
+      std::vector<std::string> overrides = o.runs.overrides;
+      for (const auto& [key, values] : o.runs.vary) {
+        REQUIRE_FALSE(values.empty());
+        overrides.push_back(key + "=" + (end == 0 ? values.front() : values.back()));
+      }
+      INFO("scene " << o.runs.scene << " with " << overrides.size() << " settings, " << (end ? "finest" : "cheapest"));
+      const Scene scene = loadScene(resolveScene(o.runs.scene), overrides);
+      CHECK((scene.spheres.size() + scene.clumps.size()) > 0);
+    }
     ++n;
   }
   CHECK(n >= 1);

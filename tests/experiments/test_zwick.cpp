@@ -89,7 +89,7 @@ TEST_CASE("zwick: a small bonded agglomerate shows a peak and a drop, and loses 
   CHECK(fs::exists(dir / "bond_breaks.csv"));
 }
 
-TEST_CASE("zwick: bonds of constant or Weibull strength; bad bond and platen keys are refused",
+TEST_CASE("zwick: bonds of constant or Weibull strength - bad bond and platen keys are refused",
           "[experiment][zwick]") {
   const Scene constant = loadScene(kZwick, kSmall);
   for (const auto& b : constant.bonds) CHECK(b.tensile_strength == 60e6);
@@ -120,7 +120,7 @@ TEST_CASE("zwick: bonds of constant or Weibull strength; bad bond and platen key
   CHECK_THAT(sceneError({"particles.0.diameter=0.004"}), Catch::Contains("two sphere radii"));
 }
 
-TEST_CASE("zwick: [bonds] type gives contact bonds (strengths in N); keys of the other kind are refused",
+TEST_CASE("zwick: [bonds] type gives contact bonds (strengths in N) - keys of the other kind are refused",
           "[experiment][zwick][bonds]") {
   auto small = [](std::vector<std::string> keys) {
     keys.insert(keys.end(), kSmall.begin(), kSmall.end());

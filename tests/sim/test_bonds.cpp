@@ -413,7 +413,7 @@ TEST_CASE("bond: restart from a checkpoint with broken bonds equals the uninterr
   CHECK(second.bondBreaks().size() + broken_at_checkpoint == whole.bondBreaks().size());
 }
 
-TEST_CASE("bond: run.h5 frames record the breakage; the reader gives the fragments back",
+TEST_CASE("bond: run.h5 frames record the breakage - the reader gives the fragments back",
           "[bonds][output]") {
   // The tension case above: the bond breaks in step 40.
   const double dt = 1e-7, v = 0.01;

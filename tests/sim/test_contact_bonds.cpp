@@ -110,7 +110,7 @@ TEST_CASE("contact bond: a parallel bond beside it holds on when the contact bon
   CHECK(force.x() == Approx(world.bonds().normal_force[0]).epsilon(1e-6));
 }
 
-TEST_CASE("contact bond: sheared it does not slip beyond mu F_n and breaks at F_c^s; the slip "
+TEST_CASE("contact bond: sheared it does not slip beyond mu F_n and breaks at F_c^s - the slip "
           "rule takes over",
           "[bonds]") {
   const double dt = 1e-7, v = 0.01, mu = 0.3;

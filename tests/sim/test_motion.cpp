@@ -174,3 +174,64 @@ TEST_CASE("leapfrog converges at second order inside a contact", "[motion]") {
     CHECK(order == Approx(2.0).margin(0.15));
   }
 }
+
+TEST_CASE("Cundall local damping: a thrown ball rises at g (1 + alpha) and falls at g (1 - alpha)", "[motion]") {
+  // Eq 2-15, sign form: the force on a free ball is its weight, |F| = m g, so the
+  // damping term -alpha |F| sign(v) makes the deceleration (1 + alpha) g while it
+  // rises and the acceleration (1 - alpha) g while it falls; a component with no
+  // force (x) and a spin with no torque are left alone.
+  const double alpha = 0.3, g = 9.81, v0 = 1.0, dt = 3.2e-5;
+  auto model = test::linearModel();
+  model.gravity = Vec3(0, 0, -g);
+  model.contact.local_damping = alpha;
+  model.timestep.dt = dt;
+  auto s = test::sphere({0, 0, 1.0}, 0.01, {0.5, 0, v0});
+  s.omega = Vec3(3, -2, 1);
+  sim::World w(model, {s}, 1);
+  const double t_up = v0 / ((1 + alpha) * g), z_peak = 1.0 + v0 * v0 / (2 * (1 + alpha) * g);
+  while (w.time() < t_up + 0.3) w.step();
+  const double tf = w.time() - t_up;
+  // The sign of v flips inside one step, which may carry the rising damping:
+  // at most 2 alpha g dt of velocity, 2 alpha g dt tf of position (+ O(dt^2)).
+  // Undamped the ball would be 0.13 m lower here; with alpha on the rise only, 0.13 m higher.
+  const double dv = 2 * alpha * g * dt, dz = dv * tf + g * dt * dt;
+  const auto& p = w.particles();
+  CHECK(std::abs(p.position[0].z() - (z_peak - 0.5 * (1 - alpha) * g * tf * tf)) < dz);
+  // The stored velocity is the half-step one.
+  CHECK(std::abs(p.velocity[0].z() + (1 - alpha) * g * (tf - 0.5 * dt)) < dv);
+  CHECK(p.velocity[0].x() == 0.5);
+  CHECK(p.omega[0] == Vec3(3, -2, 1));
+  // Falling: every step adds exactly (1 - alpha) g dt (round-off only).
+  const double v_before = p.velocity[0].z();
+  w.step();
+  CHECK(w.particles().velocity[0].z() - v_before == Approx(-(1 - alpha) * g * dt).epsilon(1e-9));
+}
+
+TEST_CASE("gravity schedule: gravity turns at the scheduled times and the ball follows the pieces", "[motion]") {
+  // Free flight under g0; at t1 a sideways 2 m/s^2 is added; at t2 gravity is
+  // switched off: x is 0 before t1, (a/2)(t - t1)^2 between, then a straight line.
+  const double a = 2.0, g = 9.81, t1 = 0.1, t2 = 0.2, dt = 3.2e-5;
+  auto model = test::linearModel();
+  model.gravity = Vec3(0, 0, -g);
+  model.gravity_changes = {{t1, Vec3(a, 0, -g)}, {t2, Vec3::Zero()}};
+  model.timestep.dt = dt;
+  sim::World w(model, {test::sphere({0, 0, 5.0}, 0.01)}, 1);
+  while (w.time() < t1 - 0.5 * dt) w.step();
+  CHECK(w.particles().position[0].x() == 0.0);
+  CHECK(w.gravity() == Vec3(0, 0, -g));
+  while (w.time() < 0.15) w.step();
+  CHECK(w.gravity() == Vec3(a, 0, -g));
+  // The switch is taken at the first step at or after its time: off by at most
+  // one step, a velocity error a dt and a position error a dt (t - t1) at most.
+  double t = w.time();
+  CHECK(std::abs(w.particles().position[0].x() - 0.5 * a * (t - t1) * (t - t1)) < a * dt * (t - t1) + 1e-12);
+  while (w.time() < 0.3) w.step();
+  CHECK(w.gravity() == Vec3::Zero());
+  t = w.time();
+  const double x_exact = 0.5 * a * (t2 - t1) * (t2 - t1) + a * (t2 - t1) * (t - t2);
+  CHECK(std::abs(w.particles().position[0].x() - x_exact) < 2 * a * dt * (t - t1) + 1e-12);
+  // Vertically: g until t2, then coasting at the speed reached.
+  const double z_exact = 5.0 - 0.5 * g * t2 * t2 - g * t2 * (t - t2);
+  CHECK(std::abs(w.particles().position[0].z() - z_exact) < 2 * g * dt * t);
+  CHECK(std::abs(w.particles().velocity[0].z() + g * t2) < g * dt);
+}

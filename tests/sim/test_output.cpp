@@ -511,8 +511,8 @@ WorldState awkwardState() {
   p.inv_inertia = {1.0 / 3.1e-7, 0.0, 1.0 / 7e-9};
   p.material = {0, 2, -1};
   p.id = {0, 42, std::numeric_limits<std::uint64_t>::max()};
-  state.pair_history = {{0, 1, {0.5, -0.25, 1.0 / 3.0}}, {1, 2, {0.0, -0.0, 1e-320}}};
-  state.wall_history = {{2, 5, {-1.0 / 7.0, 0.0, 2.0}}};
+  state.pair_history = {{0, 1, {0.5, -0.25, 1.0 / 3.0}, 1e-4 / 3.0}, {1, 2, {0.0, -0.0, 1e-320}, 0.0}};
+  state.wall_history = {{2, 5, {-1.0 / 7.0, 0.0, 2.0}, tiny}};
   return state;
 }
 
@@ -551,12 +551,14 @@ void checkSameState(const WorldState& read, const WorldState& written) {
     CHECK(read.pair_history[k].i == written.pair_history[k].i);
     CHECK(read.pair_history[k].j == written.pair_history[k].j);
     CHECK(sameBits(read.pair_history[k].shear, written.pair_history[k].shear));
+    CHECK(sameBits(read.pair_history[k].relax_offset, written.pair_history[k].relax_offset));
   }
   REQUIRE(read.wall_history.size() == written.wall_history.size());
   for (std::size_t k = 0; k < read.wall_history.size(); ++k) {
     CHECK(read.wall_history[k].particle == written.wall_history[k].particle);
     CHECK(read.wall_history[k].wall == written.wall_history[k].wall);
     CHECK(sameBits(read.wall_history[k].shear, written.wall_history[k].shear));
+    CHECK(sameBits(read.wall_history[k].relax_offset, written.wall_history[k].relax_offset));
   }
 }
 

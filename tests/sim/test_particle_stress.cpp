@@ -65,7 +65,7 @@ TEST_CASE("wall load: a moving platen's load is read where the platen is now, no
   CHECK(world.particles().position[0].norm() < 1e-12);  // the ball did not move
 }
 
-TEST_CASE("particle stress: equal principal stresses give q = 0; q is invariant under rotation",
+TEST_CASE("particle stress: equal principal stresses give q = 0 - q is invariant under rotation",
           "[stress]") {
   const sim::PrincipalStresses iso = sim::principalStresses(Mat3::Identity() * 5e6);
   CHECK(sim::octahedralShearStress(iso) == Approx(0.0).margin(1e-6));

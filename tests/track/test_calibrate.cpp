@@ -86,7 +86,15 @@ TEST_CASE("calibration from rendered checkerboards recovers the focal lengths", 
   CHECK(c.fy == Approx(truth.fy).epsilon(0.005));
   CHECK(std::abs(c.cx - truth.cx) < 3.0);
   CHECK(std::abs(c.cy - truth.cy) < 3.0);
-  CHECK(std::abs(c.k1 - truth.k1) < 0.02);
+  // Distortion: measured k1 -0.0528 (true -0.05), k2 -0.0298 (true 0): k1 and k2
+  // trade off against each other over boards that reach r^2 = 0.25 (the image
+  // corner), so each is held to twice its measured error, and their joint effect,
+  // the radial shift at the corner r (k1 r^2 + k2 r^4 - k1_true r^2) fx, to 2 px
+  // (measured 1.0 px; a fit without k1 would be 5 px off there).
+  CHECK(std::abs(c.k1 - truth.k1) < 0.006);
+  CHECK(std::abs(c.k2 - truth.k2) < 0.06);
+  const double r2 = std::pow(320.0 / 800.0, 2) + std::pow(240.0 / 800.0, 2);
+  CHECK(std::abs(((c.k1 - truth.k1) * r2 + (c.k2 - truth.k2) * r2 * r2) * std::sqrt(r2) * truth.fx) < 2.0);
   CHECK(c.rms_px < 0.2);
   CHECK(c.rvecs.size() == 6);
   CHECK(c.image_size == cv::Size(640, 480));
