@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -80,6 +81,53 @@ TEST_CASE("calibrate-bonds: each trial scales B by sigma0 / sigma, the batch is 
     drawn.insert(r["zwick"]["agglomerate_bond_strength_Pa"].get<double>());
   }
   CHECK(drawn.size() == 3);
+  fs::remove_all(c.runs.out_dir);
+}
+
+TEST_CASE("calibrate-bonds: trials over orientations take their spread out of the bonds'", "[experiment][zwick]") {
+  BondCalibrationOptions c;
+  c.runs.scene = kZwickHcp;
+  c.runs.overrides = {"particles.0.diameter=0.016", "particles.0.position=[0,0,0.009]",
+                      "experiment.platen_speed=0.05", "experiment.sample_interval=1e-5",
+                      "particles.0.orientation=\"random\""};
+  c.runs.out_dir = scratch("calibrate-bonds-orient");
+  c.runs.jobs = 0;
+  c.runs.threads = 1;
+  c.runs.progress = false;
+  const double lab_m = 3.0;
+  c.target = {"given", 20.0, 0.0, 0.0, lab_m};
+  c.max_trials = 1;
+  c.count = 3;
+  c.trial_orientations = 3;
+  std::ostringstream log;
+  REQUIRE(runBondCalibration(c, log) == kExitOk);
+  INFO(log.str());
+  const json j = readJson(c.runs.out_dir / "calibration.json");
+  const json& t = j["trials"][0];
+  // The trial is the mean of three orientations, seeds 4..6 (after the batch's 1..3).
+  const auto each = t["orientation_strengths_MPa"].get<std::vector<double>>();
+  REQUIRE(each.size() == 3);
+  CHECK(t["strength_MPa"].get<double>() == Approx((each[0] + each[1] + each[2]) / 3));
+  for (int seed = 4; seed <= 6; ++seed)
+    CHECK(fs::exists(c.runs.out_dir / "trial-1" / "runs" / ("scene.seed=" + std::to_string(seed)) / "results.json"));
+  const double cov_x = j["orientation_cov"].get<double>();
+  CHECK(cov_x > 0.0);  // a random orientation changes the crush
+  const double trial_b = j["trial_bond_strength_Pa"].get<double>(), b0 = j["calibrated_bond_strength_Pa"].get<double>();
+  const double cov_lab2 = std::tgamma(1 + 2 / lab_m) / std::pow(std::tgamma(1 + 1 / lab_m), 2) - 1;
+  if (j["bond_strength_distribution"] == "constant") {
+    // The orientations alone scatter as much as the lab: the mean goes on the lab's.
+    CHECK(1 + cov_x * cov_x >= (1 + cov_lab2) / (1 + 0.02 * 0.02));
+    CHECK(b0 == Approx(trial_b * std::tgamma(1 + 1 / lab_m)));
+  } else {
+    // 1 + CoV_lab^2 = (1 + CoV_B^2)(1 + CoV_X^2) and the batch's mean on the lab's.
+    const double m_b = j["bond_weibull_m"].get<double>();
+    CHECK(m_b > lab_m);
+    const double cov_b2 = std::tgamma(1 + 2 / m_b) / std::pow(std::tgamma(1 + 1 / m_b), 2) - 1;
+    CHECK((1 + cov_b2) * (1 + cov_x * cov_x) == Approx(1 + cov_lab2).epsilon(1e-6));
+    CHECK(b0 == Approx(trial_b * std::tgamma(1 + 1 / lab_m) / std::tgamma(1 + 1 / m_b)).epsilon(1e-9));
+  }
+  const json r = readJson(c.runs.out_dir / "batch" / "runs" / "scene.seed=1" / "results.json");
+  CHECK(r["zwick"].contains("agglomerate_bond_strength_Pa"));
   fs::remove_all(c.runs.out_dir);
 }
 

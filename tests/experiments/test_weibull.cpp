@@ -67,6 +67,13 @@ TEST_CASE("weibull: the fit recovers m and sigma0 of synthetic samples within th
   CHECK(fit.sigma0 == Approx(sigma0).epsilon(0.01));
   // Mean of a Weibull: sigma0 Gamma(1 + 1/m).
   CHECK(fit.mean == Approx(sigma0 * std::tgamma(1 + 1 / m)).epsilon(0.01));
+  CHECK(fit.mean == Approx(sigma0 * experiments::weibullMeanFactor(m)).epsilon(0.01));
+  // ...and its CoV, which weibullModulusForCov inverts (the calibration's bond modulus).
+  CHECK(fit.cov == Approx(experiments::weibullCov(m)).epsilon(0.02));
+  for (double mm : {0.8, 2.44, 3.09, 12.0, 150.0})
+    CHECK(experiments::weibullModulusForCov(experiments::weibullCov(mm)) == Approx(mm).epsilon(1e-6));
+  CHECK(experiments::weibullCov(3.09) < experiments::weibullCov(2.44));  // a larger m spreads less
+  CHECK_THROWS_AS(experiments::weibullModulusForCov(0.0), std::invalid_argument);
 }
 
 TEST_CASE("weibull: power-law size effect and bad input", "[weibull]") {

@@ -73,6 +73,27 @@ WeibullFit fitWeibull(std::vector<double> strengths) {
   return fit;
 }
 
+double weibullMeanFactor(double modulus) { return std::tgamma(1.0 + 1.0 / modulus); }
+
+double weibullCov(double modulus) {
+  const double g1 = std::tgamma(1.0 + 1.0 / modulus), g2 = std::tgamma(1.0 + 2.0 / modulus);
+  return std::sqrt(std::max(0.0, g2 / (g1 * g1) - 1.0));
+}
+
+double weibullModulusForCov(double cov) {
+  if (!(cov > 0) || !std::isfinite(cov)) {
+    std::ostringstream s;
+    s << "Weibull modulus for a CoV of " << cov << ": the CoV must be finite and > 0";
+    throw std::invalid_argument(s.str());
+  }
+  double lo = std::log(0.05), hi = std::log(1e4);  // CoV(0.05) ~ 1e10, CoV(1e4) ~ 1.3e-4
+  for (int k = 0; k < 200 && hi - lo > 1e-12; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (weibullCov(std::exp(mid)) > cov ? lo : hi) = mid;
+  }
+  return std::exp(0.5 * (lo + hi));
+}
+
 PowerLawFit fitPowerLaw(const std::vector<double>& x, const std::vector<double>& y) {
   if (x.size() != y.size() || x.size() < 2)
     throw std::invalid_argument("power-law fit: needs at least 2 (x, y) pairs of equal count");

@@ -30,6 +30,14 @@ struct PowerLawFit {
 };
 PowerLawFit fitPowerLaw(const std::vector<double>& x, const std::vector<double>& y);
 
+/// Moments of a Weibull distribution of modulus m (independent of sigma0):
+/// mean = sigma0 Gamma(1 + 1/m), CoV = sqrt(Gamma(1 + 2/m) / Gamma(1 + 1/m)^2 - 1).
+double weibullMeanFactor(double modulus);
+double weibullCov(double modulus);
+/// The modulus whose CoV is `cov` (> 0): CoV falls monotonically with m, so bisection
+/// on ln m over [0.05, 1e4]; throws std::invalid_argument for cov <= 0 or not finite.
+double weibullModulusForCov(double cov);
+
 /// A Weibull draw of modulus m and 37 % value sigma0: sigma0 (-ln U)^(1/m),
 /// U uniform in (0, 1) (experiments.md §f.6 [X]).
 double drawWeibull(double modulus, double sigma0, geometry::Rng& rng);

@@ -135,7 +135,7 @@ struct CliArgs {
   // calibrate-bonds
   std::string fraction;
   double sigma0_mpa = 0, modulus = 0, trial_strength = 60e6;
-  int count = 30, trials = 3;
+  int count = 30, trials = 3, trial_orientations = 1;
 };
 
 void addRunOptions(CLI::App* c, CliArgs& a) {
@@ -251,6 +251,11 @@ void addCommands(CLI::App& app, CliArgs& a) {
   bonds->add_option("--trials", a.trials, "Trials at most, each scaling B by sigma0 / sigma")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  bonds->add_option("--trial-orientations", a.trial_orientations,
+                    "Random orientations per trial (scene.seed after the batch's): the trial's strength is their "
+                    "mean, and their spread is taken out of the bonds' Weibull modulus")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000));
   bonds->add_option("--count", a.count, "Agglomerates in the batch")->capture_default_str()->check(CLI::Range(3, 100000));
   addRunOptions(bonds, a);
   addSetOptions(bonds, a);
@@ -348,6 +353,7 @@ int calibrateBondsCommand(const CliArgs& a) {
   c.trial_strength_Pa = a.trial_strength;
   c.max_trials = a.trials;
   c.count = a.count;
+  c.trial_orientations = a.trial_orientations;
   try {
     applySetOptions(a, c.runs);
     if (!a.fraction.empty()) {

@@ -6,7 +6,9 @@
 // tolerance; then crush a batch of agglomerates whose bond strengths are drawn
 // from a Weibull distribution of the lab's modulus m and 37 % value B0 (one
 // value per agglomerate, normal = shear strength, §f.6 [I]) and compare the
-// batch's Weibull fit (Eq 5-2..5-4) with the lab's.
+// batch's Weibull fit (Eq 5-2..5-4) with the lab's. With trial_orientations > 1
+// each trial is the mean over several orientations and the bonds' modulus is
+// corrected for the orientations' own spread (rocklab's extension, docs/crushing.md).
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -37,6 +39,10 @@ struct BondCalibrationOptions {
   double tolerance_pct = 2.0;       // a trial within this of sigma0 ends the trials
   int count = 30;                   // agglomerates of the batch (the study: 30)
   int first_seed = 1;               // scene.seed of the batch's first run (then +1, ...)
+  // Orientations per trial (scene.seed = first_seed + count, +1, ...: none of the batch's):
+  // 1 is the study's rule; K > 1 averages the trial over K orientations and takes their
+  // spread out of the bonds' (bond_calibration.cpp, bondSpreadFor).
+  int trial_orientations = 1;
 };
 
 /// Runs the trials (printing each), then the batch (a sweep over scene.seed in
