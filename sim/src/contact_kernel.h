@@ -17,6 +17,7 @@ struct PairProps {
   double friction = 0.0;   // -    min of the two (ref §5)
   double hertz_cn = 0.0;   // N/m^2 Hertz: 2 G sqrt(2) / (3 (1 - nu)); times sqrt(R~) gives c
   double hertz_ks = 0.0;   // Hertz: 2 (3 G^2 (1 - nu))^(1/3) / (2 - nu); times (R~ F)^(1/3) gives k_s
+  double hertz_ks_per_secant = 0.0;  // Hertz: hertz_ks / hertz_cn^(2/3); times K^n gives k_s (no cube root)
 };
 
 PairProps ballBallProps(const Material& a, const Material& b);
@@ -51,7 +52,8 @@ struct LinearLaw {
                      double& tangent) {
     secant = tangent = p.kn;
   }
-  static double shear(const PairProps& p, double /*fn*/, double /*r_tilde*/) { return p.ks; }
+  /// The shear stiffness at a contact whose normal secant stiffness is `secant`.
+  static double shear(const PairProps& p, double /*secant*/) { return p.ks; }
 };
 
 struct HertzMindlinLaw {
@@ -62,9 +64,11 @@ struct HertzMindlinLaw {
     secant = p.hertz_cn * std::sqrt(r_tilde * overlap);
     tangent = 1.5 * secant;
   }
-  static double shear(const PairProps& p, double fn, double r_tilde) {
-    // Eq 2-23: K^s = 2 (3 G^2 (1 - nu) R~)^(1/3) / (2 - nu) |F^n|^(1/3).
-    return p.hertz_ks * std::cbrt(r_tilde * fn);
+  static double shear(const PairProps& p, double secant) {
+    // Eq 2-23: K^s = 2 (3 G^2 (1 - nu) R~)^(1/3) / (2 - nu) |F^n|^(1/3). With the elastic
+    // F^n = c sqrt(R~ U) U (Eq 2-22), (R~ F^n)^(1/3) = c^(1/3) sqrt(R~ U) = K^n / c^(2/3):
+    // the same stiffness from the normal secant, without a cube root per contact and step.
+    return p.hertz_ks_per_secant * secant;
   }
 };
 
@@ -103,7 +107,7 @@ template <class Law>
   // Shear spring: rotate the stored force into the current tangent plane keeping
   // its magnitude, then add the increment (Eq 2-3..2-5).
   carryShear(shear, n);
-  const double ks = Law::shear(p, fn_elastic, g.r_tilde);
+  const double ks = Law::shear(p, kn_secant);
   shear += (ks * dt) * vt;  // B moving along +vt drags A along +vt
   // Coulomb limit on the elastic normal force (Eq 2-39). While slipping, the
   // spring stays at the limit and the shear dashpot is off (PFC convention, [X]).
@@ -150,7 +154,7 @@ inline double elasticEnergy(const PairProps& p, double overlap, double r_tilde, 
   const double fn = secant * overlap;
   // Linear: F U / 2; Hertz: integral of c U^(3/2) = 2/5 F U.
   const double normal = (Law::kHertz ? 0.4 : 0.5) * fn * overlap;
-  const double ks = Law::shear(p, fn, r_tilde);
+  const double ks = Law::shear(p, secant);
   return normal + (ks > 0.0 ? 0.5 * shear.squaredNorm() / ks : 0.0);
 }
 

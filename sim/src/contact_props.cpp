@@ -12,6 +12,7 @@ void setHertz(PairProps& p, double g, double nu) {
   if (g <= 0.0) return;
   p.hertz_cn = 2.0 * g * std::sqrt(2.0) / (3.0 * (1.0 - nu));            // Eq 2-22
   p.hertz_ks = 2.0 * std::cbrt(3.0 * g * g * (1.0 - nu)) / (2.0 - nu);    // Eq 2-23
+  p.hertz_ks_per_secant = p.hertz_ks / std::cbrt(p.hertz_cn * p.hertz_cn);  // HertzMindlinLaw::shear
 }
 }  // namespace
 

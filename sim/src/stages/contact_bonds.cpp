@@ -116,7 +116,7 @@ void World::Impl::installContactBond(std::size_t k) {
   detail::HertzMindlinLaw::normal(props, u0, r_tilde, secant, tangent);
   const double f0 = secant * u0;
   s.spring_normal[k] = tangent;
-  s.spring_shear[k] = detail::HertzMindlinLaw::shear(props, f0, r_tilde);
+  s.spring_shear[k] = detail::HertzMindlinLaw::shear(props, secant);
   s.reference_overlap[k] = u0 - f0 / tangent;  // U0 / 3
 }
 

@@ -57,7 +57,7 @@ void World::Impl::buildContactNetwork(detail::ContactNetwork& net) const {
     c.lever_a = cp - centre(i);
     c.lever_b = cp - centre_b;
     c.kn = tangent;
-    c.ks = sticks ? Law::shear(props, fn, r_tilde) : 0.0;
+    c.ks = sticks ? Law::shear(props, secant) : 0.0;
     // The dashpots of evaluateContact (Eq 2-16..2-18); the shear one only while sticking.
     c.cn = detail::dashpot(cm.damping_normal, damping_mass, c.kn);
     c.cs = detail::dashpot(cm.damping_shear, damping_mass, c.ks);
