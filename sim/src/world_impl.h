@@ -243,7 +243,7 @@ struct World::Impl {
   static constexpr std::size_t kMinBondsPerThread = 2000;
   int bondTeamSize() const {
     const auto useful = static_cast<int>(bonds.state.size() / kMinBondsPerThread);
-    return std::max(teamSize(), std::max(1, std::min(threads, useful)));
+    return std::max(teamSize(), std::min(threads, useful));  // teamSize() >= 1
   }
   const detail::PairProps& pairProps(std::size_t i, std::size_t j) const {
     return ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
