@@ -159,8 +159,10 @@ TEST_CASE("an output folder the run cannot write into is refused before the run"
 TEST_CASE("an earlier run in --out is refused without --overwrite and cleared with it", "[cli]") {
   const fs::path out = tempDir("earlier");
   REQUIRE(run(with({"run", kHopper, "--out", out.string()}, kShort)).code == 0);
-  // A frame of a longer earlier run, and a file nobody knows.
+  // A frame and a still of a longer earlier run, and a file of the user's.
   std::ofstream(out / "vtk" / "particles_000099.vtp") << "stale";
+  std::ofstream(out / "side_still_000009.png") << "stale";
+  std::ofstream(out / "notes.txt") << "mine";
   const std::string before = listing(out);
 
   // Refused: exit 2, every file as it was.
@@ -177,6 +179,8 @@ TEST_CASE("an earlier run in --out is refused without --overwrite and cleared wi
   Outcome o = run(with({"run", kHopper, "--out", out.string(), "--overwrite"}, kShort));
   CHECK(o.code == 0);
   CHECK_FALSE(fs::exists(out / "vtk" / "particles_000099.vtp"));
+  CHECK_FALSE(fs::exists(out / "side_still_000009.png"));
+  CHECK(slurp(out / "notes.txt") == "mine");
   CHECK(json::parse(slurp(out / "results.json"))["simulated_time_s"].get<double>() == Approx(0.001).margin(1e-5));
   // A restart into its own folder: the checkpoint is read before the folder is cleared.
   o = run({"restart", (out / "checkpoint.h5").string(), "--out", out.string(), "--overwrite", "--quiet", "--set",

@@ -35,22 +35,32 @@ std::string joined(const std::vector<std::string>& names) {
   return text;
 }
 
-bool sameFile(const fs::path& a, const fs::path& b) {
-  std::error_code ec;
-  return fs::equivalent(a, b, ec);
+/// Whether `entry` is something a run writes: its marks, the cameras' frames/, and
+/// the kinds of file runs write (stills and plots, movies, tables, JSON reports,
+/// files half-written when it stopped). Anything else (a scene, a clump or mesh
+/// file, a log, an agglomerate library) is the user's and stays.
+bool runOutput(const fs::path& entry) {
+  const std::string name = entry.filename().string();
+  if (std::find(std::begin(kRunMarks), std::end(kRunMarks), name) != std::end(kRunMarks) || name == "frames")
+    return true;
+  const std::string ext = entry.extension().string();
+  for (const char* e : {".png", ".mp4", ".avi", ".csv", ".json", ".partial", ".tmp"})
+    if (ext == e) return true;
+  return false;
 }
 
-/// Removes every entry of `dir` but the scene file and `keep`; "" or what failed.
-std::string clearFolder(const fs::path& dir, const Scene& scene, const std::vector<fs::path>& keep) {
+/// Removes the earlier run's outputs from `dir`; "" or what failed.
+std::string clearEarlierRun(const fs::path& dir) {
   std::error_code ec;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
-    const bool kept = (!scene.source.empty() && sameFile(e.path(), scene.source)) ||
-                      std::any_of(keep.begin(), keep.end(), [&](const fs::path& k) { return sameFile(e.path(), k); });
-    if (kept) continue;
-    fs::remove_all(e.path(), ec);
-    if (ec) return "cannot remove " + e.path().string() + ": " + ec.message();
+  std::vector<fs::path> outputs;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+    if (runOutput(e.path())) outputs.push_back(e.path());
+  if (ec) return "cannot list " + dir.string() + ": " + ec.message();
+  for (const fs::path& p : outputs) {
+    fs::remove_all(p, ec);
+    if (ec) return "cannot remove " + p.string() + ": " + ec.message();
   }
-  return ec ? "cannot list " + dir.string() + ": " + ec.message() : "";
+  return "";
 }
 
 /// "" when this process may create files in `dir`, else why not.
@@ -61,7 +71,7 @@ std::string notWritable(const fs::path& dir) {
 
 }  // namespace
 
-int prepareOutputFolder(const Scene& scene, const RunOptions& options, std::ostream& log) {
+int prepareOutputFolder(const RunOptions& options, std::ostream& log) {
   const fs::path& dir = options.out_dir;
   const std::string where = "output folder " + dir.string();
   std::error_code ec;
@@ -82,7 +92,7 @@ int prepareOutputFolder(const Scene& scene, const RunOptions& options, std::ostr
       return kExitBadInput;
     }
     if (!marks.empty() && options.earlier_run == EarlierRun::Replace) {
-      if (const std::string why = clearFolder(dir, scene, options.keep); !why.empty()) {
+      if (const std::string why = clearEarlierRun(dir); !why.empty()) {
         log << "error: cannot clear the earlier run in " << where << ": " << why << "\n";
         return kExitBadInput;
       }

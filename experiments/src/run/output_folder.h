@@ -10,6 +10,6 @@
 namespace rocklab::experiments::detail {
 
 /// kExitOk, or kExitBadInput with the reason on `log` (nothing touched when refused).
-int prepareOutputFolder(const Scene& scene, const RunOptions& options, std::ostream& log);
+int prepareOutputFolder(const RunOptions& options, std::ostream& log);
 
 }  // namespace rocklab::experiments::detail

@@ -145,7 +145,7 @@ int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, R
     return kExitBadInput;
   }
   countSteps(scene, setup.world->dt(), setup);
-  if (const int rc = prepareOutputFolder(scene, options, log); rc != kExitOk) return rc;
+  if (const int rc = prepareOutputFolder(options, log); rc != kExitOk) return rc;
   setup.modules = activeModules(scene, *setup.world, setup.experiment != nullptr);
   logSetup(scene, setup, options, log);
   if (const int rc = makeCameras(scene, options, log, setup); rc != kExitOk) return rc;

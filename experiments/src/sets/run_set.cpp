@@ -44,8 +44,7 @@ void runVariant(const SweepOptions& o, const std::filesystem::path& dir, Variant
   ro.out_dir = dir;
   ro.threads = o.threads;
   ro.progress = o.progress;
-  ro.earlier_run = EarlierRun::Replace;  // a calibration run again into its folder: no old file stays
-  ro.keep = {dir / "run.log"};
+  ro.earlier_run = EarlierRun::Replace;  // a calibration run again into its folder: no old output stays
   std::ofstream run_log(dir / "run.log");
   p.code = runScene(scene, ro, run_log);
   p.results = readJsonFile(dir / "results.json");

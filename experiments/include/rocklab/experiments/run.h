@@ -25,7 +25,8 @@ enum ExitCode : int {
 enum class EarlierRun {
   Keep,     // write over it file by file (callers that make fresh folders themselves)
   Refuse,   // exit 2, nothing touched (`rocklab run` without --overwrite)
-  Replace,  // clear the folder first, so no file of the old run sits beside the new ones
+  Replace,  // remove its outputs first (results.json, run.h5, checkpoint.h5, vtk/, frames/ and every
+            // .png .mp4 .avi .csv .json .partial .tmp), so no file of it sits beside the new run's
 };
 
 struct RunOptions {
@@ -34,8 +35,6 @@ struct RunOptions {
   bool progress = true;      // progress line on stderr for runs over a few seconds
   std::filesystem::path restart;  // checkpoint to continue from ("" = start at t = 0)
   EarlierRun earlier_run = EarlierRun::Keep;
-  // Files in out_dir that Replace leaves (the caller's log); the scene file is always left.
-  std::vector<std::filesystem::path> keep;
 };
 
 /// Runs a loaded scene. Returns an ExitCode; writes messages to `log`.
