@@ -76,6 +76,14 @@ TEST_CASE("particle sources stay within the ball cap and what random insertion r
   // 0.59 is above what random insertion can reach: said so, whatever the count.
   msg = errorOf(scene("\"t\"", random + "solid_fraction = 0.59\n"));
   CHECK_THAT(msg, Contains("key 'particles.0.solid_fraction' = 0.5") && Contains("above what random insertion reaches"));
+  // An HCP agglomerate is counted before it is packed (a 100 m one hung in the packing).
+  try {
+    loadScene(resolveScene("zwick-hcp"), {"particles.0.diameter=100"});
+    FAIL("no error");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Contains("key 'particles.0.diameter'") && Contains("spheres of radius 0.0025 m") &&
+                             Contains("at most 2e6"));
+  }
   // A reachable fraction that does not fit says how far insertion got.
   msg = errorOf(scene("\"t\"", "\n[[particles]]\ntype = \"random\"\nmaterial = \"rock\"\nradius = 0.01\n"
                                "region_min = [0, 0, 0]\nregion_max = [0.2, 0.2, 0.2]\nsolid_fraction = 0.3\n"));
