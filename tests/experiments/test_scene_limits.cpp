@@ -30,7 +30,7 @@ std::string errorOf(const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("scene.name is a folder name, not a path", "[scene]") {
+TEST_CASE("names that become output paths are names, not paths", "[scene]") {
   // Without --out the run writes to out/NAME: a path would write anywhere.
   for (const std::string name : {R"("/somewhere")", R"("../../x")", R"("a/b")", R"("")", R"("..")", R"("a\u0001b")",
                                  R"("a\\b")"}) {
@@ -41,6 +41,10 @@ TEST_CASE("scene.name is a folder name, not a path", "[scene]") {
            msg.find("control") != std::string::npos || msg.find("not a name") != std::string::npos));
   }
   CHECK(loadSceneText(scene(R"("chute-30_clumps.v2")", kOneBall), "ok.toml").run.name == "chute-30_clumps.v2");
+  // A camera's name makes NAME.mp4 and frames/NAME/.
+  CHECK_THAT(errorOf(scene("\"t\"", kOneBall + "\n[[cameras]]\nname = \"../../side\"\nfov_deg = 60.0\n"
+                                                "eye = [0, 0, 1]\ntarget = [0, 0, 0]\nup = [1, 0, 0]\n")),
+             Contains("key 'cameras.0.name' = \"../../side\": is a name, not a path"));
 }
 
 TEST_CASE("mesh wall triangles are whole vertex indices within the vertices", "[scene]") {

@@ -189,7 +189,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
 
       // --- [[cameras]]
       {"cameras", "", "", "A pinhole camera with radial distortion (OpenCV's model) that renders frames at its own rate. Also the tables of a `rocklab render --camera` file."},
-      {"cameras", "name", "", "Name; files are NAME.mp4, NAME_still_*.png, frames/NAME/.", nullptr, "cameraINDEX"},
+      {"cameras", "name", "", "Name; files are NAME.mp4, NAME_still_*.png, frames/NAME/, so a plain file name (no / or \\\\, not . or .., no control characters).", nullptr, "cameraINDEX"},
       {"cameras", "resolution", "px", "[width, height] in whole pixels.", "two whole numbers in [16, 8192]", "[640, 480]"},
       {"cameras", "fov_deg", "deg", "Horizontal field of view; or fx/fy/cx/cy.", nullptr, "none: fov_deg or fx"},
       {"cameras", "fx", "px", "Focal length along x (without fov_deg)."},
