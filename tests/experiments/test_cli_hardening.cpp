@@ -235,7 +235,16 @@ TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C and a second signal kills",
   }
 }
 
-TEST_CASE("shape says why it stopped and fails when it misses its target", "[cli][shape]") {
+TEST_CASE("a tool that misses what was asked says why and exits 1", "[cli][shape]") {
+  // calibrate: a target outside the values tried has no estimate.
+  const fs::path cal = tempDir("calibrate");
+  Outcome c = run({"calibrate", "drop", "--vary", "contact.damping_normal=0.3,0.4", "--target", "restitution=0.72",
+                   "--quiet", "--out", cal.string()});
+  CHECK(c.code == 1);
+  CHECK_THAT(c.err, Contains("no estimate: the target is not between any two neighbouring values"));
+  CHECK(json::parse(slurp(cal / "calibration.json"))["status"] == "no_estimate");
+  fs::remove_all(cal);
+
   const fs::path dir = tempDir("shape");
   fs::create_directories(dir);
   const std::string mesh = (dir / "p.stl").string();

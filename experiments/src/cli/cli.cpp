@@ -52,8 +52,9 @@ Examples:
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
   rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
 
-Exit codes: 0 done, 1 the run failed (its reason in results.json), 2 bad input
-(nothing written), 3 stopped by the stability
+Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
+missed what was asked (the reason in its results.json / calibration.json) or an
+unexpected error, 2 bad input (nothing written), 3 stopped by the stability
 watchdog, 4 a sweep or study finished but some runs failed (see its table),
 130 interrupted by Ctrl-C, SIGTERM or SIGHUP (outputs so far are kept and readable;
 a second signal ends the process at once).

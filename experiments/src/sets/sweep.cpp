@@ -252,11 +252,12 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
   writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
   json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
               {"target", c.target},      {"method", how},        {"runs", tried.size()},
-              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)}};
+              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+              {"status", std::isfinite(estimate) ? "done" : "no_estimate"}};
   detail::writeAtomically(dir / "calibration.json", detail::jsonText(out));
-  if (!std::isfinite(estimate)) {
-    log << "calibrate: no estimate: " << how << "; widen the values\n";
-    return kExitOk;
+  if (!std::isfinite(estimate)) {  // the target was asked for and not found: not a success
+    log << "error: calibrate: no estimate: " << how << "; widen the values\n";
+    return kExitFailed;
   }
   log << "calibrate: " << key << " = " << cell(estimate) << " gives " << c.target_metric << " = " << c.target << " ("
       << how << ")\n  check it: rocklab run " << o.scene << " --set " << key << "=" << cell(estimate) << "\n";
