@@ -24,7 +24,7 @@ json() { sed -n "s/.*\"$2\": \([-0-9.e+]*\).*/\1/p" "$1" | head -1; }
 printf '%-8s %10s %10s %14s %16s %14s\n' threads spheres bonds "bond stage s" "bond-steps/s" "p-steps/s"
 for t in 1 2; do
   dir="$out/bonds-$t"
-  "$rocklab" run zwick-hcp --out "$dir" --threads "$t" --quiet \
+  "$rocklab" run zwick-hcp --out "$dir" --overwrite --threads "$t" --quiet \
     --set particles.0.diameter="$diameter" --set particles.0.position="[0,0,$diameter]" \
     --set experiment.platen_speed=1e-9 --set scene.end_time=0 --set scene.steps="$steps" --set output.hdf5=false >"$dir.log" 2>&1 ||
     { echo "run failed: $dir.log" >&2; exit 1; }

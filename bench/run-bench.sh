@@ -37,7 +37,7 @@ json() {  # json FILE KEY -> first numeric value of "KEY": in the file
 run_rocklab() {  # scene n threads steps args... -> sets ps (particle-steps/s), rss (bytes), touch (pairs/sphere)
   local scene=$1 n=$2 t=$3 steps=$4; shift 4
   local dir="$out/rocklab-$scene-$n-$t"
-  "$rocklab" run "$root/bench/scenes/$scene.toml" --out "$dir" --threads "$t" --quiet \
+  "$rocklab" run "$root/bench/scenes/$scene.toml" --out "$dir" --overwrite --threads "$t" --quiet \
     --set scene.steps="$steps" "$@" >"$dir.log" 2>&1
   ps=$(json "$dir/results.json" particle_steps_per_s)
   rss=$(json "$dir/results.json" peak_rss_bytes)
@@ -96,7 +96,7 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = grid ]; then
   printf '\ngrid_levels,N,steps,rebuilds,neighbour_ms_per_rebuild,particle_steps_per_s\n'
   for lv in 8 1; do
     dir="$out/rocklab-grid-$lv"
-    "$rocklab" run "$root/bench/scenes/polydisperse.toml" --out "$dir" --threads 1 --quiet \
+    "$rocklab" run "$root/bench/scenes/polydisperse.toml" --out "$dir" --overwrite --threads 1 --quiet \
       --set neighbours.max_levels=$lv >"$dir.log" 2>&1
     rb=$(json "$dir/results.json" neighbour_rebuilds)
     printf '%s,%s,%s,%s,%.2f,%.3g\n' "$( [ $lv = 1 ] && echo single || echo multi)" "$(json "$dir/results.json" particles)" \

@@ -50,7 +50,7 @@ while IFS= read -r line; do
   dir="$work/$row"
   start=$(date +%s.%N)
   set +e
-  "$bin" run "$scene" --out "$dir" --threads 1 --quiet "${args[@]}" >"$dir.log" 2>&1
+  "$bin" run "$scene" --out "$dir" --overwrite --threads 1 --quiet "${args[@]}" >"$dir.log" 2>&1
   rc=$?
   set -e
   secs=$(printf '%.1f' "$(echo "$(date +%s.%N) - $start" | bc -l)")

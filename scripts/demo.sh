@@ -4,4 +4,4 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/setup.sh"
-"$root/build/app/rocklab" demo --out "${1:-$root/out/demo}"
+"$root/build/app/rocklab" demo --overwrite --out "${1:-$root/out/demo}"

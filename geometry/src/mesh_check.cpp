@@ -13,6 +13,7 @@
 #include <assimp/scene.h>
 
 #include "assimp_mesh.h"
+#include "rocklab/geometry/mesh_file_check.h"
 
 namespace rocklab::geometry {
 
@@ -72,6 +73,10 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
   if (!std::filesystem::exists(path, ec))
     throw MeshCheckError("mesh file '" + path + "' does not exist");
   if (!std::ifstream(path).good()) throw MeshCheckError("mesh file '" + path + "' cannot be opened for reading");
+  // assimp aborts on some malformed files: only a file whose structure agrees with
+  // its own counts is handed to it.
+  if (const std::string problem = meshFileProblem(path); !problem.empty())
+    throw MeshCheckError("mesh file '" + path + "' cannot be read: " + problem);
   Assimp::Importer importer;
   // No JoinIdenticalVertices here: welding is done below across all meshes of the file.
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);

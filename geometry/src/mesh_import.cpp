@@ -5,10 +5,15 @@
 #include <assimp/scene.h>
 
 #include "assimp_mesh.h"
+#include "rocklab/geometry/mesh_file_check.h"
 
 namespace rocklab::geometry {
 
 TriangleMesh importMesh(const std::string& path, double scale) {
+  // assimp aborts on some malformed files: only a file whose structure agrees with
+  // its own counts is handed to it.
+  if (const std::string problem = meshFileProblem(path); !problem.empty())
+    throw MeshImportError("cannot read mesh '" + path + "': " + problem);
   Assimp::Importer importer;
   // Per-face normals keep STL vertices apart; drop normals so that welding works.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "rocklab/geometry/clump_shape.h"
+#include "rocklab/geometry/mesh_properties.h"
 #include "rocklab/geometry/mesh_voxels.h"
 
 namespace rocklab::geometry {
@@ -187,7 +188,7 @@ std::vector<SurfacePoint> sampleSurface(const TriangleMesh& mesh, int count, std
   return out;
 }
 
-std::vector<Sphere> meshToClump(const TriangleMesh& mesh, const MeshToClumpOptions& o) {
+ClumpResult meshToClumpWithStop(const TriangleMesh& mesh, const MeshToClumpOptions& o) {
   if (o.max_spheres < 1) throw std::invalid_argument("meshToClump: max_spheres must be >= 1");
   if (!(o.volume_tolerance >= 0 && o.volume_tolerance < 1))
     throw std::invalid_argument("meshToClump: volume_tolerance must be in [0, 1)");
@@ -203,16 +204,49 @@ std::vector<Sphere> meshToClump(const TriangleMesh& mesh, const MeshToClumpOptio
   if (cand.empty())
     throw std::runtime_error("meshToClump: no candidate sphere has a radius >= min_radius (" +
                              std::to_string(o.min_radius) + " of the equivalent diameter); lower it");
+  // A chosen ball refined on the exact distance to the mesh: the grid places a medial
+  // ball to ± h/2, the touch tolerance a surface sphere's centre to within t.
+  const double refine_step = medial ? g.h : std::max(o.touch_tolerance * d_eq, 1e-3 * d_eq);
+  // The true uncovered fraction 1 − V_union / V_mesh of the refined spheres: what the
+  // tolerance means and what `rocklab shape` reports (volume_error). The voxel count
+  // only says when it is worth computing: it misses up to a few % (cells cut by the
+  // surface, refinement), so a stop on it alone ends above the tolerance.
+  const double mesh_volume = meshMassProperties(mesh).volume;
+  auto trueUncovered = [&](const std::vector<Sphere>& refined) {
+    return 1.0 - clumpMassProperties(refined, 1.0, ClumpMassDistribution::Union).union_volume / mesh_volume;
+  };
 
   // Lazy greedy maximum coverage.
   std::vector<std::uint8_t> covered(g.inside.size(), 0);
   std::priority_queue<std::pair<std::size_t, std::size_t>> queue;  // (gain bound, candidate), largest first
   for (std::size_t c = 0; c < cand.size(); ++c) queue.push({coverage(g, covered, cand[c], false), c});
-  std::vector<Sphere> chosen;
+  ClumpResult result;
+  result.stop = ClumpStop::Spheres;
   std::size_t uncovered = inside_total;
-  while (static_cast<int>(chosen.size()) < o.max_spheres && !queue.empty()) {
-    if (static_cast<double>(uncovered) <= o.volume_tolerance * static_cast<double>(inside_total) && !chosen.empty())
+  const bool tolerance = o.volume_tolerance > 0;
+  std::size_t checked = 0;  // spheres when the true fraction was last computed
+  while (true) {
+    if (tolerance && result.spheres.size() > checked &&
+        static_cast<double>(uncovered) <= o.volume_tolerance * static_cast<double>(inside_total)) {
+      checked = result.spheres.size();
+      result.uncovered = trueUncovered(result.spheres);
+      if (result.uncovered <= o.volume_tolerance) {
+        result.stop = ClumpStop::Tolerance;
+        return result;
+      }
+    }
+    if (static_cast<int>(result.spheres.size()) >= o.max_spheres) {
+      result.stop = ClumpStop::Spheres;
       break;
+    }
+    if (uncovered == 0) {
+      result.stop = ClumpStop::Covered;
+      break;
+    }
+    if (queue.empty()) {
+      result.stop = ClumpStop::Exhausted;
+      break;
+    }
     auto [bound, c] = queue.top();
     queue.pop();
     const std::size_t gain = coverage(g, covered, cand[c], false);
@@ -222,13 +256,26 @@ std::vector<Sphere> meshToClump(const TriangleMesh& mesh, const MeshToClumpOptio
       continue;
     }
     uncovered -= coverage(g, covered, cand[c], true);
-    chosen.push_back(cand[c]);
+    result.spheres.push_back(refineBall(mesh, cand[c].centre, refine_step));
   }
-  if (medial)  // the grid places a ball to ± h/2: refine it on the exact distance
-    for (Sphere& s : chosen) s = refineBall(mesh, s.centre, g.h);
-  else  // the tolerance placed the centre to within t: refine it there on the exact distance
-    for (Sphere& s : chosen) s = refineBall(mesh, s.centre, std::max(o.touch_tolerance * d_eq, 1e-3 * d_eq));
-  return chosen;
+  result.uncovered = trueUncovered(result.spheres);
+  return result;
+}
+
+std::vector<Sphere> meshToClump(const TriangleMesh& mesh, const MeshToClumpOptions& o) {
+  return meshToClumpWithStop(mesh, o).spheres;
+}
+
+const char* clumpStopReason(ClumpStop stop) {
+  switch (stop) {
+    case ClumpStop::Spheres: return "sphere count reached (--spheres)";
+    case ClumpStop::Tolerance: return "tolerance reached (--tolerance)";
+    case ClumpStop::Covered: return "every inside grid cell covered: more spheres add no volume";
+    case ClumpStop::Exhausted:
+      return "no candidate sphere adds volume (the rest of the inside is thinner than --min-radius allows, or "
+             "finer than --grid resolves)";
+  }
+  return "";
 }
 
 ClumpFitError clumpFitError(const MeshMassProperties& mesh_props, const std::vector<Sphere>& spheres,

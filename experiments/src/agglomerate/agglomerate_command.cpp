@@ -14,6 +14,7 @@
 #include "agglomerate/agglomerate_methods.h"
 #include "agglomerate/agglomerate_preview.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/run.h"  // ExitCode
 #include "rocklab/geometry/mesh_check.h"
 
@@ -270,7 +271,7 @@ int runUnguarded(const AgglomerateOptions& o, std::ostream& log) {
             {"agglomerates", rows},
             {"wall_time_s", since(t_start)}};
   if (mesh) r["dense_diameter_m"] = mesh->dense_diameter;
-  detail::writeAtomically(results, r.dump(2) + "\n");
+  detail::writeAtomically(results, detail::jsonText(r));
   log << o.count << " agglomerate(s) → " << o.out.string() << " (" << results.filename().string()
       << ", " << preview_note << "); " << since(t_start) << " s\n";
   return kExitOk;

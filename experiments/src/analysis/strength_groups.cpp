@@ -11,6 +11,7 @@
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/run.h"  // exit codes
 
 namespace rocklab::experiments {
@@ -176,7 +177,7 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
     spec.series = {points, line};
   }
   detail::writeAtomically(dir / "strength_groups.csv", csv.str());
-  detail::writeAtomically(dir / "strength_groups.json", j.dump(2) + "\n");
+  detail::writeAtomically(dir / "strength_groups.json", detail::jsonText(j));
   try {
     writePlot(spec, dir / "strength_groups.png");
   } catch (const std::exception& e) {

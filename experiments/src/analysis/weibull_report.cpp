@@ -10,6 +10,7 @@
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/run.h"  // exit codes
 
 namespace rocklab::experiments {
@@ -54,7 +55,7 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
   j["method"] =
       "mean rank P_s = 1 - i/(N+1) (Eq 5-2), least squares of ln ln(1/P_s) on ln sigma (Eq 5-4)";
   j["strengths_MPa"] = fit.sorted;
-  detail::writeAtomically(dir / "weibull.json", j.dump(2) + "\n");
+  detail::writeAtomically(dir / "weibull.json", detail::jsonText(j));
   PlotSeries points{"runs", {}, {}, PlotSeries::Style::Points};
   for (std::size_t i = 0; i < fit.count; ++i) {
     points.x.push_back(std::log(fit.sorted[i]));

@@ -1,6 +1,10 @@
 #include "rocklab/experiments/cli.h"
 
 #include <CLI/CLI.hpp>
+#include <H5Cpp.h>
+
+#include <iterator>
+#include <new>
 #include <csignal>
 #include <fstream>
 #include <functional>
@@ -12,6 +16,7 @@
 #include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
 #include "camera/render_run.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/bond_calibration.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
@@ -21,6 +26,7 @@
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/world.h"
 #include "scene/scene_keys.h"
+#include "sets/plan_file.h"
 
 namespace rocklab::experiments {
 
@@ -46,18 +52,43 @@ Examples:
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
   rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
 
-Exit codes: 0 done, 1 the run failed (its reason in results.json), 2 bad input
-(nothing written), 3 stopped by the stability
+Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
+missed what was asked (the reason in its results.json / calibration.json) or an
+unexpected error, 2 bad input (nothing written), 3 stopped by the stability
 watchdog, 4 a sweep or study finished but some runs failed (see its table),
-130 interrupted by Ctrl-C (outputs so far are kept and readable).
+130 interrupted by Ctrl-C, SIGTERM or SIGHUP (outputs so far are kept and readable;
+a second signal ends the process at once).
 Sweeps and studies run each variant as its own process of one thread, one per
 core (--jobs N; --jobs 0 runs them here one after the other with --threads).
 Units are SI everywhere (m, s, kg, N, Pa).)";
 
-extern "C" void onSigint(int) {
+// The signals that ask a run to stop cleanly: Ctrl-C, and SIGTERM and SIGHUP, which
+// schedulers (Slurm at its time limit) and closed terminals send.
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+extern "C" void onStopSignal(int) {
   requestStop();
-  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the process at once
+  // A second stop signal, of any of the three kinds, ends the process at once.
+  for (const int s : kStopSignals) std::signal(s, SIG_DFL);
 }
+
+/// While alive, SIGINT, SIGTERM and SIGHUP request a clean stop (checkpoint, results.json
+/// with status "interrupted", exit 130); the handlers before it come back afterwards.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    for (std::size_t k = 0; k < std::size(kStopSignals); ++k) previous_[k] = std::signal(kStopSignals[k], onStopSignal);
+  }
+  ~StopOnSignals() {
+    for (std::size_t k = 0; k < std::size(kStopSignals); ++k) std::signal(kStopSignals[k], previous_[k]);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+ private:
+  using Handler = void (*)(int);
+  Handler previous_[std::size(kStopSignals)]{};
+};
 
 std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
 
@@ -121,7 +152,7 @@ struct CliArgs {
   std::string weibull_column = "strength_MPa", group_by, size_column;
   std::vector<std::string> overrides;
   int threads = 0;
-  bool quiet = false, skip_complete = false;
+  bool quiet = false, skip_complete = false, overwrite = false;
   // sweep, calibrate, study
   std::vector<std::string> vary, metrics;
   std::string target, plan_dir, figure, reference;
@@ -189,6 +220,10 @@ void addCommands(CLI::App& app, CliArgs& a) {
   auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
   restart->add_option("checkpoint", a.checkpoint_arg, "checkpoint.h5 written by an earlier run")->required();
   addRunOptions(restart, a);
+  for (CLI::App* c : {run, demo, restart})
+    c->add_flag("--overwrite", a.overwrite,
+                "Replace an earlier run in --out (its files are removed first); without it such a folder is "
+                "refused");
   auto* check = app.add_subcommand("check", "Validate a scene and print its time-step audit without running");
   check->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", a.overrides, "Override a scene key")->take_all();
@@ -284,7 +319,7 @@ void addCommands(CLI::App& app, CliArgs& a) {
 }
 
 int studyCommand(const CliArgs& a) {
-  std::signal(SIGINT, onSigint);
+  const StopOnSignals stop_on_signals;
   try {
     StudyOptions so;
     if (const auto file = findStudyFile(a.scene_arg)) so = loadStudyFile(*file);
@@ -322,7 +357,7 @@ int sweepCommand(const CliArgs& a, bool calibrate) {
   so.out_dir = a.out_dir;
   so.threads = a.threads;
   so.progress = !a.quiet;
-  std::signal(SIGINT, onSigint);
+  const StopOnSignals stop_on_signals;
   try {
     for (const std::string& v : a.vary) so.vary.push_back(parseVary(v));
     if (!calibrate) {
@@ -372,6 +407,7 @@ int calibrateBondsCommand(const CliArgs& a) {
     std::cerr << "error: calibrate-bonds: " << e.what() << "\n";
     return kExitBadInput;
   }
+  const StopOnSignals stop_on_signals;
   return runBondCalibration(c, std::cerr);
 }
 
@@ -381,6 +417,7 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
   RunOptions options;
   options.threads = a.threads;
   options.progress = !a.quiet;
+  options.earlier_run = a.overwrite ? EarlierRun::Replace : EarlierRun::Refuse;
   try {
     if (command == "restart") {
       // The checkpoint carries the scene text it was run with.
@@ -415,22 +452,17 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
 
   options.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(a.out_dir);
   if (a.skip_complete) {
-    std::ifstream in(options.out_dir / "results.json");
-    const nlohmann::json r = in ? nlohmann::json::parse(in, nullptr, false) : nlohmann::json();
-    if (r.is_object() && r.value("status", "") == "completed") {
+    if (detail::resultStatus(detail::readJsonFile(options.out_dir / "results.json")) == "completed") {
       std::cerr << "rocklab: " << (options.out_dir / "results.json").string() << " is complete; not run again\n";
       return kExitOk;
     }
   }
-  std::signal(SIGINT, onSigint);
-  const int code = runScene(scene, options, std::cerr);
-  std::signal(SIGINT, SIG_DFL);
-  return code;
+  const StopOnSignals stop_on_signals;
+  return runScene(scene, options, std::cerr);
 }
 
-}  // namespace
-
-int runCli(int argc, const char* const* argv) {
+/// The command line parsed and run; `name` is set to the subcommand's name once known.
+int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
   CLI::App app{"rocklab: DEM workbench for laboratory experiments on rock flow and breakage"};
   app.footer(kExamples);
   app.require_subcommand(1);
@@ -450,6 +482,7 @@ int runCli(int argc, const char* const* argv) {
     app.exit(e);
     return kExitBadInput;
   }
+  if (const auto subcommands = app.get_subcommands(); !subcommands.empty()) name = "rocklab " + subcommands.front()->get_name();
 
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("scene-keys")) return doSceneKeys(a.collect_dir);
@@ -481,6 +514,28 @@ int runCli(int argc, const char* const* argv) {
   for (const char* command : {"restart", "demo", "check"})
     if (app.got_subcommand(command)) return sceneCommand(a, command);
   return sceneCommand(a, "run");
+}
+
+}  // namespace
+
+int runCli(int argc, const char* const* argv) {
+  // The last line of defence: whatever a command did not catch ends here with a
+  // message and a documented exit code, never in std::terminate. Causes found
+  // are fixed where they arise, with the file and value named there.
+  std::string command = "rocklab";
+  try {
+    return runCliUnguarded(argc, argv, command);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "error: " << command
+              << ": out of memory (the input asks for more memory than this machine can give)\n";
+  } catch (const H5::Exception& e) {
+    std::cerr << "error: " << command << ": HDF5: " << e.getDetailMsg() << " (" << e.getFuncName() << ")\n";
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << command << ": " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "error: " << command << ": stopped by an unexpected error\n";
+  }
+  return kExitFailed;
 }
 
 }  // namespace rocklab::experiments

@@ -10,6 +10,7 @@
 
 #include "camera/wall_placement.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "run/run_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -166,7 +167,7 @@ void writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup
   json r = runJson(scene, setup, record, times);
   reportCameras(setup, times, r, log);
   reportExperiment(scene, options, setup, record, r, log);
-  writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
+  writeAtomically(options.out_dir / "results.json", jsonText(r));
 
   if (!record.message.empty()) log << "error: " << record.message << "\n";
   const sim::World& world = *setup.world;

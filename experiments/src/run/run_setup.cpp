@@ -5,6 +5,7 @@
 #include <ostream>
 
 #include "rocklab/sim/output/checkpoint.h"
+#include "run/output_folder.h"
 #include "run/run_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -144,20 +145,19 @@ int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, R
     return kExitBadInput;
   }
   countSteps(scene, setup.world->dt(), setup);
-  std::error_code ec;
-  std::filesystem::create_directories(options.out_dir, ec);
-  if (ec) {
-    log << "error: cannot create output directory " << options.out_dir << ": " << ec.message()
-        << "\n";
-    return kExitBadInput;
-  }
+  if (const int rc = prepareOutputFolder(options, log); rc != kExitOk) return rc;
   setup.modules = activeModules(scene, *setup.world, setup.experiment != nullptr);
   logSetup(scene, setup, options, log);
   if (const int rc = makeCameras(scene, options, log, setup); rc != kExitOk) return rc;
-  if (scene.run.hdf5)
-    setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);
-  if (scene.run.vtk)
-    setup.vtk = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "particles");
+  try {
+    if (scene.run.hdf5)
+      setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);
+    if (scene.run.vtk)
+      setup.vtk = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "particles");
+  } catch (const std::exception& e) {  // the folder was writable a moment ago: a full disk, a quota
+    log << "error: cannot start the outputs in " << options.out_dir.string() << ": " << e.what() << "\n";
+    return kExitFailed;
+  }
   return kExitOk;
 }
 

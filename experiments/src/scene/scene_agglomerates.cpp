@@ -4,6 +4,8 @@
 // written by `rocklab agglomerate` (dense random packing §f.4, carved from a
 // scan §f.7, or HCP), with its bonds, or a dense random packing made here
 // (§f.4: the same generator as `rocklab agglomerate --method dense`).
+#include <cmath>
+#include <iomanip>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -43,6 +45,15 @@ void readHcp(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sp
   // between the stacking axis and y, which the platens of a test along y see.
   const double angle = t.number("hcp_angle", 0.0, Range::closed(0, 90));
   const double gap_tolerance = t.number("gap_tolerance", 1e-3, Range::closed(0, 0.5));
+  // Counted before the packing is made (a 100 m sphere of 2.5 mm balls hung in it):
+  // HCP fills 0.7405 of the sphere.
+  const double expected = 0.7405 * std::pow(diameter / (2 * radius), 3);
+  if (expected > 2e6) {
+    std::ostringstream what;
+    what << std::setprecision(3) << "gives about " << expected << " spheres of radius " << radius
+         << " m; an agglomerate may have at most 2e6";
+    t.fail("diameter", what.str());
+  }
   try {
     body = geometry::hcpPacking(radius, diameter, angle);
   } catch (const std::invalid_argument& e) {

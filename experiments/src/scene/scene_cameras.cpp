@@ -12,6 +12,7 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
   for (TableReader t : root.tableArray("cameras")) {
     CameraSettings c;
     c.name = t.string("name", "camera" + std::to_string(cameras.size()));
+    if (const std::string problem = folderNameProblem(c.name); !problem.empty()) t.fail("name", problem);
     for (const auto& other : cameras)
       if (other.name == c.name) t.fail("name", "another camera has this name");
     std::vector<double> res = t.numberList("resolution", Range::closed(16, 8192));

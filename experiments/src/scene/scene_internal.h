@@ -22,6 +22,10 @@ namespace rocklab::experiments::detail {
 using geometry::Vec3;
 
 void readRunTable(TableReader& root, RunSettings& run);
+/// Why `name` cannot name a folder or file of the outputs (scene.name is out/NAME
+/// without --out, a camera's NAME.mp4 and frames/NAME/): "" when it can. One plain
+/// name: not a path ("/x", "../x", "a/b"), not empty, no control characters.
+std::string folderNameProblem(const std::string& name);
 void readOutput(TableReader& root, RunSettings& run);
 
 /// Material name -> index into model.materials.

@@ -37,7 +37,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
 
       // --- [scene]
       {"scene", "", "", "What the run is called and how long it lasts. Give exactly one of end_time and steps."},
-      {"scene", "name", "", "Name of the run; the default output folder is out/NAME."},
+      {"scene", "name", "", "Name of the run; the default output folder is out/NAME, so a plain folder name: not empty, no / or \\\\, not . or .., no control characters, at most 100 characters."},
       {"scene", "description", "", "One line shown by `rocklab list`."},
       {"scene", "seed", "", "Seed of every random choice (insertion, orientations, bond strengths); equal seeds give equal runs."},
       {"scene", "end_time", "s", "Simulated time at which the run ends (an experiment may end it earlier); 0 = use steps."},
@@ -112,7 +112,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"walls", "angle_deg", "deg", "(plate) Angle of the length side above the x axis."},
       {"walls", "file", "", "(mesh) STL, PLY or OBJ file, relative to the scene file."},
       {"walls", "scale", "", "(mesh) Factor on the coordinates (0.001 for a file in mm)."},
-      {"walls", "triangles", "", "(mesh) Triangles as vertex indices [[i, j, k], ...], without `file`."},
+      {"walls", "triangles", "", "(mesh) Triangles as vertex indices [[i, j, k], ...] (whole numbers from 0, each below the vertex count), without `file`."},
       {"walls", "min", "m", "(box) Lower corner."},
       {"walls", "max", "m", "(box) Upper corner."},
       {"walls", "open_top", "", "(box) Leave out the top face."},
@@ -142,11 +142,11 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"particles", "cell", "m", "(lattice) Cell size."},
       {"particles", "offset", "m", "(lattice) Offset of the first point from the corner."},
       {"particles", "corner", "m", "(lattice) Corner of the lattice."},
-      {"particles", "counts", "", "(lattice) Cells along x, y, z (whole numbers, 1-10000)."},
+      {"particles", "counts", "", "(lattice) Cells along x, y, z (whole numbers, 1-10000); the scene holds at most 1e7 balls (about 15 GB)."},
       {"particles", "region_min", "m", "(random) Lower corner of the insertion box."},
       {"particles", "region_max", "m", "(random) Upper corner of the insertion box."},
       {"particles", "count", "", "(random) Number of bodies; or solid_fraction.", nullptr, "none: count or solid_fraction"},
-      {"particles", "solid_fraction", "", "(random) Bodies to fill this fraction of the box volume (a size sweep fills the same space).", nullptr, "none: count or solid_fraction"},
+      {"particles", "solid_fraction", "", "(random) Bodies to fill this fraction of the box volume (a size sweep fills the same space). Random insertion reaches about 0.27 with equal spheres, less with a size range or clumps: above 0.3 is refused. A scene holds at most 1e7 balls.", nullptr, "none: count or solid_fraction"},
       {"particles", "positions", "m", "(list) Body positions (clumps: centres of mass)."},
       {"particles", "radii", "m", "(list) One radius per position (spheres)."},
       {"particles", "velocities", "m/s", "(list) One velocity per position."},
@@ -189,7 +189,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
 
       // --- [[cameras]]
       {"cameras", "", "", "A pinhole camera with radial distortion (OpenCV's model) that renders frames at its own rate. Also the tables of a `rocklab render --camera` file."},
-      {"cameras", "name", "", "Name; files are NAME.mp4, NAME_still_*.png, frames/NAME/.", nullptr, "cameraINDEX"},
+      {"cameras", "name", "", "Name; files are NAME.mp4, NAME_still_*.png, frames/NAME/, so a plain file name (no / or \\\\, not . or .., no control characters).", nullptr, "cameraINDEX"},
       {"cameras", "resolution", "px", "[width, height] in whole pixels.", "two whole numbers in [16, 8192]", "[640, 480]"},
       {"cameras", "fov_deg", "deg", "Horizontal field of view; or fx/fy/cx/cy.", nullptr, "none: fov_deg or fx"},
       {"cameras", "fx", "px", "Focal length along x (without fov_deg)."},

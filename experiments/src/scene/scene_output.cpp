@@ -4,6 +4,17 @@
 
 namespace rocklab::experiments::detail {
 
+std::string folderNameProblem(const std::string& name) {
+  if (name.empty()) return "must not be empty";
+  if (name == "." || name == "..") return "is not a name ('.' and '..' are folders)";
+  if (name.find_first_of("/\\") != std::string::npos)
+    return "is a name, not a path: no '/' or '\\' (it names an output folder or file)";
+  for (const char c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "must not hold control characters";
+  if (name.size() > 100) return "must be at most 100 characters (it names an output folder or file)";
+  return "";
+}
+
 /// [scene]: name, description, seed and the end (end_time or steps).
 void readRunTable(TableReader& root, RunSettings& run) {
   auto t = root.table("scene");
@@ -12,6 +23,7 @@ void readRunTable(TableReader& root, RunSettings& run) {
               "missing; a [scene] table with name and end_time (or "
               "steps) is required");
   run.name = t->requiredString("name");
+  if (const std::string problem = folderNameProblem(run.name); !problem.empty()) t->fail("name", problem);
   run.description = t->string("description", "");
   run.seed = static_cast<std::uint64_t>(t->integer("seed", 1, Range::nonNegative()));
   run.end_time = t->number("end_time", 0.0, Range::nonNegative());

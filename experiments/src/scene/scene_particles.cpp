@@ -2,7 +2,9 @@
 // clumps (four_ball, clump files) with their mass properties.
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 
 #include "rocklab/geometry/clump_shape.h"
 #include "rocklab/geometry/packing.h"
@@ -11,6 +13,49 @@
 namespace rocklab::experiments::detail {
 
 namespace {
+
+// The most balls (clump members counted) a scene may make, as `count` allows, and
+// what one ball costs in memory: the World's per-ball state and contact history,
+// the neighbour grid and pair lists, the scene's own copy. Measured 0.98 kB a ball
+// (results.json peak_rss_bytes of touching simple-cubic lattices of 8,000 and
+// 216,000 balls, 3 pairs a ball); 1.5 kB leaves room for denser packs and outputs.
+constexpr double kMaxBalls = 1e7;
+constexpr double kBytesPerBall = 1500;
+// Random insertion (no overlap; each body tried 1000 times; it stops at the first
+// body that does not fit) fills about 0.27 of a box with equal spheres (measured at
+// 20 and 40 radii across: 0.275, 0.271), less with a size range (0.22 at r_max/r_min
+// = 2) or clumps. Denser packs come from a lattice or from letting a deposit settle.
+constexpr double kRandomInsertionReach = 0.3;
+
+std::string memoryText(double balls) {
+  const double gb = balls * kBytesPerBall / 1e9;
+  std::ostringstream s;
+  s << std::setprecision(2) << gb << " GB";
+  return s.str();
+}
+
+/// Refuses a source that would take the scene past kMaxBalls before anything is
+/// allocated for it, with the count and the memory it would take.
+void checkBallBudget(const TableReader& t, const std::string& key, double bodies, double balls_per_body,
+                     std::size_t balls_before) {
+  const double balls = bodies * balls_per_body;
+  if (balls + static_cast<double>(balls_before) <= kMaxBalls) return;
+  std::ostringstream what;
+  what << std::setprecision(3) << "asks for " << bodies << (balls_per_body > 1 ? " clumps" : " balls");
+  if (balls_per_body > 1) what << " of " << balls_per_body << " balls";
+  if (balls_before) what << " after " << balls_before << " balls of the sources before it";
+  what << ": about " << memoryText(balls + static_cast<double>(balls_before)) << " of memory at ~"
+       << kBytesPerBall / 1e3 << " kB a ball; a scene may hold at most " << kMaxBalls << " balls (about "
+       << memoryText(kMaxBalls) << ")";
+  t.fail(key, what.str());
+}
+
+/// Balls of the scene so far, clump members included.
+std::size_t ballsSoFar(const Scene& scene) {
+  std::size_t n = scene.spheres.size();
+  for (const sim::ClumpSpec& c : scene.clumps) n += c.members.size();
+  return n;
+}
 
 /// A body shape of one particle source: a sphere, or a clump with its members
 /// in the principal frame centred on the centre of mass.
@@ -167,6 +212,9 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
       const auto lk = kind == "sc"    ? geometry::LatticeKind::SimpleCubic
                       : kind == "bcc" ? geometry::LatticeKind::BodyCentred
                                       : geometry::LatticeKind::FaceCentred;
+      const double per_cell = kind == "sc" ? 1 : kind == "bcc" ? 2 : 4;
+      checkBallBudget(t, "counts", per_cell * counts.prod(),
+                      clumps ? static_cast<double>(body.members.size()) : 1.0, ballsSoFar(scene));
       points = geometry::latticePoints(lk, cell, offset, corner, n);
       radii.assign(points.size(), radius);
     } else if (type == "random") {
@@ -195,13 +243,34 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
                "give exactly one of count (particles) and "
                "solid_fraction (of the region volume, "
                "so that a size sweep fills the same space)");
-      std::int64_t count = t.integer("count", 0, Range::closed(1, 1e7));
+      std::int64_t count = t.integer("count", 0, Range::closed(1, kMaxBalls));
+      const double region = (hi - lo).cwiseMax(Vec3::Zero()).prod();
       if (t.has("solid_fraction")) {
-        const double f = t.number("solid_fraction", 0, {0.0, 0.6, true, false});
-        const double region = (hi - lo).cwiseMax(Vec3::Zero()).prod();
-        count = static_cast<std::int64_t>(std::floor(f * region / body_volume));
+        const double f = t.number("solid_fraction", 0, {0.0, 1.0, true, true});
+        if (f > kRandomInsertionReach) {
+          std::ostringstream what;
+          what << "above what random insertion reaches: it places bodies one by one without overlap and fills "
+                  "about 0.27 of a region with equal spheres, less with a size range or clumps (at most "
+               << kRandomInsertionReach
+               << " is accepted); for a denser pack use a lattice or let a looser one settle under gravity";
+          t.fail("solid_fraction", what.str());
+        }
+        const double bodies = std::floor(f * region / body_volume);
+        checkBallBudget(t, "solid_fraction", bodies, clumps ? static_cast<double>(body.members.size()) : 1.0,
+                        ballsSoFar(scene));
+        count = static_cast<std::int64_t>(bodies);
         if (count < 1) t.fail("solid_fraction", "gives no particle in this region");
+      } else {
+        checkBallBudget(t, "count", static_cast<double>(count),
+                        clumps ? static_cast<double>(body.members.size()) : 1.0, ballsSoFar(scene));
       }
+      // What the bodies placed fill of the region, for the message when they stop short.
+      auto reached = [&](std::size_t placed_bodies) {
+        std::ostringstream s;
+        s << " (random insertion stopped at a solid fraction of " << std::setprecision(2)
+          << static_cast<double>(placed_bodies) * body_volume / region << " of the region)";
+        return s.str();
+      };
       if (clumps) {
         const std::vector<const std::vector<geometry::Sphere>*> shapes(
             static_cast<std::size_t>(count), &body.members);
@@ -209,7 +278,7 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
         if (poses.size() < shapes.size())
           t.fail(t.has("count") ? "count" : "solid_fraction",
                  "only " + std::to_string(poses.size()) + " of " + std::to_string(shapes.size()) +
-                     " clumps fit in the region without overlap; enlarge "
+                     " clumps fit in the region without overlap" + reached(poses.size()) + "; enlarge "
                      "region_min/region_max or ask for fewer");
         for (const auto& pose : poses) {
           points.push_back(pose.position);
@@ -221,7 +290,7 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
         if (points.size() < radii.size())
           t.fail(t.has("count") ? "count" : "solid_fraction",
                  "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
-                     " spheres fit in the region without overlap; enlarge "
+                     " spheres fit in the region without overlap" + reached(points.size()) + "; enlarge "
                      "region_min/region_max or ask for fewer");
       }
     } else {

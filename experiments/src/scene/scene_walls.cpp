@@ -90,13 +90,9 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
       } else {
         w.mesh.vertices = t.vec3List("vertices");
         for (Vec3& v : w.mesh.vertices) v *= scale;
-        const auto tris = t.vec3List("triangles");
-        if (tris.empty())
+        w.mesh.triangles = t.indexTriples("triangles", w.mesh.vertices.size());
+        if (w.mesh.triangles.empty())
           t.fail("triangles", "a mesh wall needs `file` or `vertices` + `triangles`");
-        for (const Vec3& tri : tris)
-          w.mesh.triangles.push_back({static_cast<std::uint32_t>(tri[0]),
-                                      static_cast<std::uint32_t>(tri[1]),
-                                      static_cast<std::uint32_t>(tri[2])});
       }
       const std::string msg = w.mesh.validate();
       if (!msg.empty()) t.fail(t.has("file") ? "file" : "triangles", msg);

@@ -1,6 +1,7 @@
 #include "scene/toml_reader.h"
 
 #include <charconv>
+#include <cmath>
 #include <mutex>
 #include <sstream>
 
@@ -267,6 +268,34 @@ std::vector<double> TableReader::numberList(const std::string& key, Range range)
     if (!toNumber(e, v)) fail(key, "expected an array of finite numbers " + range.describe());
     if (!range.contains(v)) fail(key, "an element is out of range; allowed: " + range.describe());
     out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::array<std::uint32_t, 3>> TableReader::indexTriples(const std::string& key, std::size_t count) {
+  note(key, "array of [i, j, k]", "whole numbers, 0 to the vertex count - 1", "[]");
+  const toml::node* n = node(key);
+  std::vector<std::array<std::uint32_t, 3>> out;
+  if (!n) return out;
+  auto a = n->as_array();
+  if (!a) fail(key, "expected an array of [i, j, k] vertex indices");
+  const std::string allowed = count ? "whole numbers 0 to " + std::to_string(count - 1) + " (" +
+                                          std::to_string(count) + " vertices)"
+                                    : "none: there are no vertices";
+  for (std::size_t row = 0; row < a->size(); ++row) {
+    const auto triple = a->get(row)->as_array();
+    if (!triple || triple->size() != 3)
+      fail(key, "entry " + std::to_string(row) + " is not an array of 3 vertex indices [i, j, k]");
+    std::array<std::uint32_t, 3>& t = out.emplace_back();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const toml::node& e = *triple->get(k);
+      double v = 0;
+      const bool number = toNumber(e, v);
+      if (!number || v != std::floor(v) || v < 0 || v >= static_cast<double>(count))
+        fail(key, "entry " + std::to_string(row) + " [i, j, k]: " + (number ? numberText(v) : typeName(e)) +
+                      " is not a vertex index; allowed: " + allowed);
+      t[k] = static_cast<std::uint32_t>(v);
+    }
   }
   return out;
 }

@@ -3,6 +3,8 @@
 // finish() rejects keys that nobody read (pbrt's "unused parameter" rule).
 #include <toml++/toml.h>
 
+#include <array>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -64,6 +66,9 @@ class TableReader {
   geometry::Vec3 requiredVec3(const std::string& key);
   std::vector<geometry::Vec3> vec3List(const std::string& key);
   std::vector<double> numberList(const std::string& key, Range range = {});
+  /// An array of [i, j, k] index triples, each a whole number in [0, count) (mesh
+  /// triangles into `count` vertices).
+  std::vector<std::array<std::uint32_t, 3>> indexTriples(const std::string& key, std::size_t count);
   std::vector<std::string> stringList(const std::string& key, const std::vector<std::string>& allowed = {});
   /// An array of any TOML values, each as TOML text ("0.5", "\"linear\"", "[960, 400]"),
   /// the form --set takes.

@@ -15,6 +15,7 @@
 #include "analysis/weibull.h"
 #include "analysis/weibull_report.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
 
@@ -249,7 +250,7 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
   j["batch"] = {{"dir", "batch"}, {"count", c.count}, {"first_seed", c.first_seed}};
   if (batch.plan_only) {
     j["batch"]["planned"] = true;
-    detail::writeAtomically(dir / "calibration.json", j.dump(2) + "\n");
+    detail::writeAtomically(dir / "calibration.json", detail::jsonText(j));
     log << "calibrate-bonds: batch planned; after it ran: rocklab collect " << batch.out_dir.string()
         << " && rocklab weibull " << batch.out_dir.string() << "\n";
     return kExitOk;
@@ -270,7 +271,7 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
     if (c.target.mean_MPa > 0) log << " (lab " << c.target.mean_MPa << ")";
     log << ", R^2 " << w["weibull_r2"].get<double>() << "\n";
   }
-  detail::writeAtomically(dir / "calibration.json", j.dump(2) + "\n");
+  detail::writeAtomically(dir / "calibration.json", detail::jsonText(j));
   log << "calibrate-bonds: " << (dir / "calibration.json").string() << "\n";
   if (batch_code != kExitOk) return batch_code;
   return fit_code;

@@ -18,6 +18,8 @@
 #include <thread>
 
 #include "common/atomic_file.h"
+#include "common/json_text.h"
+#include "sets/plan_file.h"
 
 extern char** environ;
 
@@ -70,10 +72,7 @@ fs::path selfExecutable() {
 }
 
 bool complete(const fs::path& results) {
-  std::ifstream in(results);
-  if (!in) return false;
-  const json r = json::parse(in, nullptr, false);
-  return !r.is_discarded() && r.is_object() && r.value("status", "") == "completed";
+  return resultStatus(readJsonFile(results)) == "completed";
 }
 
 /// What went wrong, from a run's log: its last "error..." line (the watchdog's or the
@@ -135,7 +134,7 @@ std::vector<PlannedRun> planRuns(const SweepOptions& o) {
 std::string runCommand(const fs::path& set_dir, const std::string& scene_path, const PlannedRun& run) {
   const fs::path dir = fs::absolute(set_dir);
   std::string line = shellQuote(selfExecutable().string()) + " run " + shellQuote(scene_path) + " --out " +
-                     shellQuote((dir / "runs" / run.name).string()) + " --threads 1 --quiet --skip-complete";
+                     shellQuote((dir / "runs" / run.name).string()) + " --threads 1 --quiet --skip-complete --overwrite";
   for (const std::string& s : run.overrides) line += " --set " + shellQuote(s);
   const fs::path logs = dir / "logs";
   line += " > " + shellQuote((logs / (run.name + ".log")).string()) + " 2>&1; echo $? > " +
@@ -161,7 +160,7 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   plan["overrides"] = o.overrides;
   plan["vary"] = vary;
   plan["runs"] = list;
-  writeAtomically(dir / "plan.json", plan.dump(2) + "\n");
+  writeAtomically(dir / "plan.json", jsonText(plan));
   writeAtomically(dir / "runs.txt", lines);
 
   std::ostringstream sb;
@@ -186,7 +185,8 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
      << "Each line of `runs.txt` is one run: `rocklab run` with its own `--out` folder under `runs/`, every\n"
      << "`--set` it needs (the seed included), one thread, its log and exit code under `logs/`. A line\n"
      << "whose run already completed does nothing (`--skip-complete`), so running the list again, or\n"
-     << "after deleting one run folder, redoes only what is missing.\n\n"
+     << "after deleting one run folder, redoes only what is missing (an unfinished attempt's files are\n"
+     << "removed first: `--overwrite`).\n\n"
      << "Run the list on this machine with GNU parallel (one run per core):\n\n"
      << "    parallel --jobs " << defaultJobs() << " < " << (dir / "runs.txt").string() << "\n\n"
      << "or on a Slurm cluster as an array job (one task per line; resources in the header):\n\n"
@@ -203,9 +203,9 @@ std::vector<Variant> inspectRuns(const fs::path& set_dir, const std::vector<Plan
     v.values = run.values;
     const fs::path results = set_dir / "runs" / run.name / "results.json";
     // A stopped run's results (watchdog, Ctrl-C) still tell something.
-    if (std::ifstream in(results); in) v.results = json::parse(in, nullptr, false);
+    v.results = readJsonFile(results);
     if (v.results.is_discarded()) v.results = nullptr;
-    if (v.results.is_object() && v.results.value("status", "") == "completed") {
+    if (resultStatus(v.results) == "completed") {
       v.code = kExitOk;
       v.status = "ok";
       continue;
@@ -259,6 +259,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
       ro.out_dir = set_dir / "runs" / r->name;
       ro.threads = o.threads;
       ro.progress = o.progress;
+      ro.earlier_run = EarlierRun::Replace;  // what an interrupted attempt left (a complete run is skipped above)
       int code;
       {
         std::ofstream run_log(set_dir / "logs" / (r->name + ".log"));

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 
 namespace rocklab::experiments::detail {
 
@@ -43,10 +44,10 @@ void runVariant(const SweepOptions& o, const std::filesystem::path& dir, Variant
   ro.out_dir = dir;
   ro.threads = o.threads;
   ro.progress = o.progress;
+  ro.earlier_run = EarlierRun::Replace;  // a calibration run again into its folder: no old output stays
   std::ofstream run_log(dir / "run.log");
   p.code = runScene(scene, ro, run_log);
-  std::ifstream in(dir / "results.json");
-  if (in) p.results = json::parse(in, nullptr, false);
+  p.results = readJsonFile(dir / "results.json");
   log << "  ";
   for (std::size_t k = 0; k < o.vary.size(); ++k) log << o.vary[k].first << " = " << p.values[k] << "  ";
   log << "-> " << (p.code == kExitOk ? "done" : "exit " + std::to_string(p.code)) << " (" << dir.string() << ")\n";

@@ -10,6 +10,7 @@
 #include <toml++/toml.h>
 
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "analysis/plot.h"
 #include "sets/run_plan.h"
 #include "sets/run_set.h"
@@ -293,7 +294,7 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
               {"recommended", a.recommended ? json("runs/" + runs[rows_in[*a.recommended].members.front()].name) : json(nullptr)},
               {"recommendation", line},
               {"complete", allOk(done)}};
-  writeAtomically(dir / "study.json", out.dump(2) + "\n");
+  writeAtomically(dir / "study.json", jsonText(out));
   try {
     writeStudyPlot(o, a, name, dir / "study.png");
   } catch (const std::exception& e) {

@@ -11,7 +11,9 @@
 #include <stdexcept>
 
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "analysis/plot.h"
+#include "sets/plan_file.h"
 #include "sets/run_plan.h"
 #include "sets/run_set.h"
 #include "sets/study_report.h"
@@ -149,32 +151,22 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
 }
 
 int collectSet(const std::filesystem::path& dir, std::ostream& log) {
-  std::ifstream in(dir / "plan.json");
-  const json plan = in ? json::parse(in, nullptr, false) : json();
-  if (!plan.is_object() || !plan.contains("runs")) {
-    log << "error: collect: " << (dir / "plan.json").string()
-        << " is missing or unreadable; give the folder of a sweep or study (made with --plan or --jobs)\n";
+  PlanFile plan;
+  try {
+    plan = readPlanFile(dir);
+  } catch (const PlanFileError& e) {
+    log << "error: collect: " << e.what() << "\n";
     return kExitBadInput;
   }
-  SweepOptions o;
-  o.scene = plan.value("scene", "");
-  o.overrides = plan.value("overrides", std::vector<std::string>{});
-  for (const json& v : plan["vary"]) o.vary.emplace_back(v["key"].get<std::string>(), v["values"].get<std::vector<std::string>>());
-  std::vector<PlannedRun> runs;
-  for (const json& r : plan["runs"])
-    runs.push_back({r["name"].get<std::string>(), r["values"].get<std::vector<std::string>>(),
-                    r["overrides"].get<std::vector<std::string>>(), r.value("invalid", "")});
-  const std::vector<Variant> done = inspectRuns(dir, runs);
+  const SweepOptions& o = plan.options;
+  const std::vector<Variant> done = inspectRuns(dir, plan.runs);
   std::size_t complete = 0, failed = 0, missing = 0;
   for (const Variant& v : done) (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
-  const std::string kind = plan.value("kind", "");
   const std::string name = std::filesystem::path(o.scene).stem().string();
-  log << "collect " << kind << " of " << name << ": " << complete << " complete, " << failed << " failed, " << missing
-      << " missing of " << runs.size() << " runs\n";
-  if (kind == "sweep") return reportSweep(dir, o, plan["metrics"].get<std::vector<std::string>>(), done, name, log);
-  if (kind == "study") return collectStudy(dir, o, plan, runs, done, log);
-  log << "error: collect: " << (dir / "plan.json").string() << ": unknown kind '" << kind << "'\n";
-  return kExitBadInput;
+  log << "collect " << plan.kind << " of " << name << ": " << complete << " complete, " << failed << " failed, "
+      << missing << " missing of " << plan.runs.size() << " runs\n";
+  if (plan.kind == "sweep") return reportSweep(dir, o, plan.metrics, done, name, log);
+  return collectStudy(dir, o, plan.raw, plan.runs, done, log);
 }
 
 int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
@@ -260,11 +252,12 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
   writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
   json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
               {"target", c.target},      {"method", how},        {"runs", tried.size()},
-              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)}};
-  detail::writeAtomically(dir / "calibration.json", out.dump(2) + "\n");
-  if (!std::isfinite(estimate)) {
-    log << "calibrate: no estimate: " << how << "; widen the values\n";
-    return kExitOk;
+              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+              {"status", std::isfinite(estimate) ? "done" : "no_estimate"}};
+  detail::writeAtomically(dir / "calibration.json", detail::jsonText(out));
+  if (!std::isfinite(estimate)) {  // the target was asked for and not found: not a success
+    log << "error: calibrate: no estimate: " << how << "; widen the values\n";
+    return kExitFailed;
   }
   log << "calibrate: " << key << " = " << cell(estimate) << " gives " << c.target_metric << " = " << c.target << " ("
       << how << ")\n  check it: rocklab run " << o.scene << " --set " << key << "=" << cell(estimate) << "\n";

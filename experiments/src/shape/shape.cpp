@@ -14,6 +14,7 @@
 #include "common/preview_renderer.h"
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/geometry/mesh_check.h"
@@ -44,6 +45,7 @@ double since(Clock::time_point t0) {
 // Implausible particle sizes in metres: a file in mm read as m gives a 20 m pebble,
 // one in m read as mm a 0.02 mm grain.
 constexpr double kSmallestParticle = 1e-4;
+constexpr double kSmallestInMillimetres = 1e-3;  // with --unit mm: under 1 mm across, probably metres
 constexpr double kLargestParticle = 5.0;
 // Surface samples for the surface error (and the surface method's random nodes).
 constexpr int kErrorSamples = 20000;
@@ -109,11 +111,16 @@ Prepared prepare(const ShapeOptions& o, std::ostream& log) {
   auto props = geometry::meshMassProperties(raw, o.density);
   auto shape = geometry::shapeDescriptors(raw, props);
   p.largest_as_read = shape.long_dim;
-  if (p.largest_as_read < kSmallestParticle || p.largest_as_read > kLargestParticle) {
+  // A scan in metres read with --unit mm is a thousand times too small: below a
+  // millimetre across it is far more likely that than a grain of sand.
+  const double smallest = o.unit == "mm" ? kSmallestInMillimetres : kSmallestParticle;
+  if (p.largest_as_read < smallest || p.largest_as_read > kLargestParticle) {
     std::ostringstream w;
     w << "implausible size for --unit " << o.unit << ": longest dimension " << p.largest_as_read
-      << " m (a particle is expected between " << kSmallestParticle << " and " << kLargestParticle
-      << " m); check the unit (--unit mm or m)";
+      << " m (a particle is expected between " << smallest << " and " << kLargestParticle << " m); ";
+    if (o.unit == "mm" && p.largest_as_read < smallest) w << "the file is probably in metres: give --unit m";
+    else if (o.unit == "m" && p.largest_as_read > kLargestParticle) w << "the file is probably in mm: give --unit mm";
+    else w << "check the unit (--unit mm or m)";
     p.check.warnings.push_back(w.str());
     log << "warning: mesh '" << o.mesh << "': " << w.str() << "\n";
   }
@@ -287,8 +294,7 @@ void runPile(const ShapeOptions& o, const Prepared& p, const std::vector<Sphere>
   if (runScene(scene, ro, run_log) != kExitOk)
     throw std::runtime_error("pile run failed: " + run_log.str());
   row.pile_wall_s = since(t0);
-  std::ifstream in(dir / "results.json");
-  const json r = json::parse(in);
+  const json r = detail::readJsonFile(dir / "results.json");
   row.ball_steps_per_s = r.at("particle_steps_per_s").get<double>();
   row.clump_steps_per_s = row.ball_steps_per_s / n;
   row.pile_dt =
@@ -328,12 +334,29 @@ struct ShapeTimes {
   double read = 0, generate = 0, errors = 0, preview = 0;
 };
 
-/// The clump of the asked method and size.
-std::vector<Sphere> makeClump(const ShapeOptions& o, const Prepared& p, ShapeTimes& times) {
+/// The clump of the asked method and size, and why the generator stopped.
+geometry::ClumpResult makeClump(const ShapeOptions& o, const Prepared& p, ShapeTimes& times) {
   const auto t0 = Clock::now();
-  std::vector<Sphere> spheres = geometry::meshToClump(p.mesh, clumpOptions(o, o.method, o.spheres));
+  geometry::ClumpResult clump = geometry::meshToClumpWithStop(p.mesh, clumpOptions(o, o.method, o.spheres));
   times.generate = since(t0);
-  return spheres;
+  return clump;
+}
+
+/// Whether the clump reached what was asked: with --tolerance the uncovered volume
+/// fraction; without, the sphere count (or a fully covered inside, where more
+/// spheres add nothing). "" when met, else what was not.
+std::string targetMissed(const ShapeOptions& o, const geometry::ClumpResult& clump) {
+  std::ostringstream s;
+  if (o.tolerance > 0) {
+    if (clump.uncovered <= o.tolerance) return "";
+    s << "--tolerance " << o.tolerance << " not reached: " << std::setprecision(3) << 100 * clump.uncovered
+      << " % of the volume uncovered with " << clump.spheres.size() << " spheres";
+  } else {
+    if (clump.stop == geometry::ClumpStop::Spheres || clump.stop == geometry::ClumpStop::Covered) return "";
+    s << "--spheres " << o.spheres << " not reached: " << clump.spheres.size() << " spheres";
+  }
+  s << " (" << geometry::clumpStopReason(clump.stop) << ")";
+  return s.str();
 }
 
 /// Its errors against the mesh.
@@ -563,13 +586,15 @@ int runShapeUnguarded(const ShapeOptions& o, std::ostream& log) {
   }
   times.read = since(times.start);
 
-  std::vector<Sphere> spheres;
+  geometry::ClumpResult clump;
   try {
-    spheres = makeClump(o, p, times);
+    clump = makeClump(o, p, times);
   } catch (const std::exception& e) {
     log << "error: mesh '" << o.mesh << "': " << e.what() << "\n";
     return kExitBadInput;
   }
+  const std::vector<Sphere>& spheres = clump.spheres;
+  const std::string missed = targetMissed(o, clump);
   const auto samples = geometry::sampleSurface(p.mesh, kErrorSamples, o.seed + 1);
   const geometry::ClumpFitError err = fitError(p, spheres, samples, times);
   std::filesystem::create_directories(o.out_dir);
@@ -584,13 +609,21 @@ int runShapeUnguarded(const ShapeOptions& o, std::ostream& log) {
     if (o.pile) writeCostPlot(o, rows);
   }
   const std::string preview_note = previewStep(o, p, spheres, times, log);
-  const json r = resultsJson(o, p, spheres, err, rows, times, preview_note);
-  detail::writeAtomically(o.out_dir / "results.json", r.dump(2) + "\n");
+  json r = resultsJson(o, p, spheres, err, rows, times, preview_note);
+  r["status"] = missed.empty() ? "done" : "target_not_met";
+  r["stop_reason"] = geometry::clumpStopReason(clump.stop);
+  r["uncovered_volume_fraction"] = clump.uncovered;
+  if (!missed.empty()) r["message"] = missed;
+  detail::writeAtomically(o.out_dir / "results.json", detail::jsonText(r));
   log << o.mesh << ": " << spheres.size() << " spheres (" << o.method << "), volume error "
       << std::showpos << 100 * err.volume_error << std::noshowpos << " %, inertia error "
       << 100 * err.inertia_error << " %, surface error mean " << 1e3 * err.surface_error_mean
-      << " mm, max " << 1e3 * err.surface_error_max << " mm; " << times.generate << " s → "
-      << o.out_dir.string() << "\n";
+      << " mm, max " << 1e3 * err.surface_error_max << " mm; stopped: " << geometry::clumpStopReason(clump.stop)
+      << "; " << times.generate << " s → " << o.out_dir.string() << "\n";
+  if (!missed.empty()) {
+    log << "error: " << missed << "; the clump is written, but it is not what was asked\n";
+    return kExitFailed;
+  }
   return kExitOk;
 }
 

@@ -17,7 +17,16 @@ enum ExitCode : int {
   kExitBadInput = 2,     // scene, option or file the user gave is unusable; nothing written
   kExitWatchdog = 3,     // the stability watchdog stopped the run; outputs so far kept
   kExitRunsFailed = 4,   // a multi-run command finished, but some of its runs failed (see its table)
-  kExitInterrupted = 130,  // Ctrl-C; outputs so far kept and readable
+  kExitInterrupted = 130,  // Ctrl-C, SIGTERM or SIGHUP; outputs so far kept and readable
+};
+
+/// What a run does with an earlier run in its output folder (a folder holding
+/// results.json, run.h5, checkpoint.h5 or vtk/, finished or not).
+enum class EarlierRun {
+  Keep,     // write over it file by file (callers that make fresh folders themselves)
+  Refuse,   // exit 2, nothing touched (`rocklab run` without --overwrite)
+  Replace,  // remove its outputs first (results.json, run.h5, checkpoint.h5, vtk/, frames/ and every
+            // .png .mp4 .avi .csv .json .partial .tmp), so no file of it sits beside the new run's
 };
 
 struct RunOptions {
@@ -25,12 +34,13 @@ struct RunOptions {
   int threads = 0;           // 0 = all cores
   bool progress = true;      // progress line on stderr for runs over a few seconds
   std::filesystem::path restart;  // checkpoint to continue from ("" = start at t = 0)
+  EarlierRun earlier_run = EarlierRun::Keep;
 };
 
 /// Runs a loaded scene. Returns an ExitCode; writes messages to `log`.
 int runScene(const Scene& scene, const RunOptions& options, std::ostream& log);
 
-/// Requests a clean stop of the running scene (called from the SIGINT handler).
+/// Requests a clean stop of the running scene (called from the SIGINT, SIGTERM and SIGHUP handler).
 void requestStop();
 /// True after requestStop() until the next run starts.
 bool stopRequested();

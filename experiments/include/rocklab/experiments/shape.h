@@ -32,7 +32,10 @@ struct ShapeOptions {
   std::filesystem::path out_dir;     // required
 };
 
-/// Runs the command; returns an ExitCode (0, or 2 with one message on `log` for bad input).
+/// Runs the command; returns an ExitCode: 0; 2 with one message on `log` for bad input;
+/// 1 when the clump is written but misses the asked --tolerance, or stops below
+/// --spheres without covering the inside (results.json status "target_not_met",
+/// its stop_reason and uncovered_volume_fraction).
 int runShape(const ShapeOptions& options, std::ostream& log);
 
 }  // namespace rocklab::experiments

@@ -24,8 +24,8 @@
 // Greedy selection (both): candidates with radius >= min_radius; each step takes the
 // candidate that covers the most inside grid cells not yet covered (lazy greedy: a
 // candidate's gain can only shrink, so stale gains are upper bounds). It stops at
-// max_spheres, when the uncovered fraction of the inside cells is <= volume_tolerance,
-// or when no candidate adds anything. The output is in selection order, so its first
+// max_spheres, when the true uncovered volume fraction is <= volume_tolerance, or
+// when no candidate adds anything. The output is in selection order, so its first
 // k spheres are what the method gives for k spheres.
 #include <cstdint>
 #include <string>
@@ -55,8 +55,29 @@ struct MeshToClumpOptions {
   std::uint64_t seed = 1;
 };
 
-/// Spheres in selection order. Throws std::invalid_argument for bad options and
+/// Why the selection stopped.
+enum class ClumpStop {
+  Spheres,    // max_spheres reached
+  Tolerance,  // the true uncovered fraction fell to volume_tolerance
+  Covered,    // every inside grid cell covered: another sphere adds nothing the grid sees
+  Exhausted,  // cells are left, but no candidate covers any of them (min_radius, grid)
+};
+const char* clumpStopReason(ClumpStop stop);
+
+struct ClumpResult {
+  std::vector<Sphere> spheres;  // in selection order, refined
+  ClumpStop stop = ClumpStop::Spheres;
+  double uncovered = 0;         // 1 − V_union / V_mesh at the stop (true volumes, not the grid's)
+};
+
+/// Spheres in selection order and why the selection stopped. With volume_tolerance
+/// the stop test is the true uncovered fraction of the refined spheres (computed
+/// once the grid's estimate passes the tolerance), so a clump that stops on the
+/// tolerance is within it. Throws std::invalid_argument for bad options and
 /// std::runtime_error when no candidate reaches min_radius.
+ClumpResult meshToClumpWithStop(const TriangleMesh& mesh, const MeshToClumpOptions& options);
+
+/// meshToClumpWithStop's spheres.
 std::vector<Sphere> meshToClump(const TriangleMesh& mesh, const MeshToClumpOptions& options);
 
 struct SurfacePoint {
