@@ -14,6 +14,7 @@
 #include "camera/camera_recorder.h"
 #include "drivers/experiment.h"
 #include "rocklab/experiments/run.h"
+#include "rocklab/sim/output/file_write.h"
 #include "rocklab/sim/output/run_file.h"
 #include "rocklab/sim/output/vtk_series.h"
 #include "rocklab/sim/world.h"
@@ -34,6 +35,9 @@ struct RunSetup {
   std::vector<std::unique_ptr<CameraRecorder>> cameras;
   std::unique_ptr<sim::output::RunFile> run_file;  // null without output.hdf5
   std::unique_ptr<sim::output::VtkSeries> vtk;     // null without output.vtk
+  // Space for results.json set aside at the start: a disk that fills up during
+  // the run still takes the file that says the run failed.
+  std::unique_ptr<sim::output::ReservedFile> results_file;
   double dt = 0.0;  // s, of the first World: the step counts below are made with it
   std::uint64_t total_steps = 0;
   // Steps between trajectory frames, energy rows and checkpoints (0 = none).
@@ -55,6 +59,7 @@ struct RunRecord {
   /// interrupted run becomes failed; a run already stopped keeps its status and
   /// adds the reason.
   void outputFailed(const std::string& reason) {
+    if (message.find(reason) != std::string::npos) return;  // the same output failing again
     if (status == "completed" || status == "interrupted") {
       status = "failed";
       exit_code = kExitFailed;

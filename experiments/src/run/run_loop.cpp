@@ -212,9 +212,15 @@ class RunLoop {
   void finishOutputs() {
     const auto t0 = Clock::now();
     sim::output::RunFile* run_file = setup_.run_file.get();
-    if (run_file && run_file->failed()) run_file->discard();
+    const bool run_file_failed = run_file && run_file->failed();
+    if (run_file_failed) {
+      run_file->discard();
+      const std::string partial = (options_.out_dir / "run.h5.partial").string();
+      if (record_.message.find(partial) == std::string::npos)
+        record_.outputFailed("run file '" + partial + "': a write to it failed; removed");
+    }
     if (record_.exit_code != kExitWatchdog) guardOutput([&] { writeCheckpoint(); });
-    if (run_file && !run_file->failed())
+    if (run_file && !run_file_failed)
       guardOutput([&] {
         run_file->close(record_.exit_code != kExitOk);
         record_.run_file_kept = true;

@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "camera/wall_placement.h"
-#include "common/atomic_file.h"
 #include "run/run_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -185,7 +184,7 @@ int writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup,
     r["message"] = record.message;
   }
   try {
-    writeAtomically(options.out_dir / "results.json", r.dump(2) + "\n");
+    setup.results_file->write(r.dump(2) + "\n");
   } catch (const std::exception& e) {
     log << "error: " << e.what() << "\n";
     if (record.exit_code == kExitOk) record.exit_code = kExitFailed;

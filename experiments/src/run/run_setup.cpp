@@ -201,6 +201,8 @@ int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, R
   setup.modules = activeModules(scene, *setup.world, setup.experiment != nullptr);
   logSetup(scene, setup, options, log);
   if (const int rc = makeCameras(scene, options, log, setup); rc != kExitOk) return rc;
+  // 64 KiB: a plain run's results.json takes 5, an experiment's a few tens.
+  setup.results_file = std::make_unique<out::ReservedFile>(options.out_dir / "results.json", 64 * 1024);
   try {
     if (scene.run.hdf5)
       setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);

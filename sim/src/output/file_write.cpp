@@ -33,6 +33,53 @@ bool writeAll(int fd, std::string_view bytes) {
 
 }  // namespace
 
+ReservedFile::ReservedFile(std::filesystem::path path, std::size_t bytes) : path_(std::move(path)) {
+  const std::string partial = path_.string() + ".partial";
+  fd_ = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ >= 0 && ::posix_fallocate(fd_, 0, static_cast<off_t>(bytes)) != 0) {
+    ::close(fd_);  // no space even now: no reservation
+    fd_ = -1;
+    ::unlink(partial.c_str());
+  }
+}
+
+ReservedFile::~ReservedFile() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  ::unlink((path_.string() + ".partial").c_str());
+}
+
+void ReservedFile::write(std::string_view bytes) {
+  if (fd_ < 0) {
+    writeFileAtomically(path_, bytes);
+    return;
+  }
+  const std::filesystem::path temporary = path_.string() + ".partial";
+  const int fd = fd_;
+  fd_ = -1;  // used: whatever happens, it is not removed twice
+  const auto fail = [&](int errnum) {
+    ::close(fd);
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    return OutputError("cannot write '" + path_.string() + "': " + systemReason(errnum));
+  };
+  if (!writeAll(fd, bytes)) throw fail(errno);
+  if (::ftruncate(fd, static_cast<off_t>(bytes.size())) != 0) throw fail(errno);  // the unused rest
+  if (::close(fd) != 0) {
+    const int errnum = errno;
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw OutputError("cannot write '" + path_.string() + "': " + systemReason(errnum));
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path_, error);
+  if (error) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw OutputError("cannot write '" + path_.string() + "': " + systemReason(error.value()));
+  }
+}
+
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
   const std::filesystem::path temporary = path.string() + ".partial";
   const auto fail = [&](int errnum) {

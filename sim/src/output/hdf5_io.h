@@ -3,10 +3,6 @@
 // array element type is stored, and writing datasets and attributes with the
 // "unit" convention and a checksum. Internal to rocklab_sim.
 #include <H5Cpp.h>
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/resource.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <array>
@@ -27,6 +23,17 @@ void recordHdf5Errors();
 /// What went wrong, with the system's reason first when a system call failed:
 /// "no space left on device (H5File::close: H5Fclose failed)".
 std::string hdf5Failure(const H5::Exception& e);
+/// Files being written on disk, by their sec2 file descriptor (FileHandle): when
+/// a system call of HDF5 fails (a full disk) each is diverted at once, inside the
+/// failing call, to an anonymous in-memory file, so that everything HDF5 does
+/// with them afterwards (the closes during unwinding, the final close) succeeds.
+/// Needed because HDF5 1.10 frees an object whose close failed but keeps its id,
+/// and a later close or its clean-up at exit then crashes. The diverted file's
+/// contents are lost: its owner removes it.
+void watchForFailure(int* fd);
+void unwatch(int* fd);
+/// Why a watched file was diverted ("" while it was not).
+std::string diverted(int* fd);
 
 /// An HDF5 file for writing, closed exactly once. HDF5 1.10 crashes when a file
 /// whose close failed (a full disk) is closed again, as H5::H5File's destructor
@@ -46,13 +53,16 @@ class FileHandle {
     H5Pclose(access);
     if (id_ < 0) throw H5::FileIException("H5Fcreate", "cannot create '" + path + "'");
     root_ = H5::Group(H5Gopen2(id_, "/", H5P_DEFAULT));
+    void* handle = nullptr;
+    if (!in_memory && H5Fget_vfd_handle(id_, H5P_DEFAULT, &handle) >= 0 && handle != nullptr) {
+      fd_ = static_cast<int*>(handle);  // the sec2 driver's handle is its file descriptor
+      watchForFailure(fd_);
+    }
   }
   ~FileHandle() {
     if (id_ < 0) return;
-    if (H5Fflush(id_, H5F_SCOPE_GLOBAL) < 0)
-      abandon();  // the close would fail as well
-    else
-      H5Fclose(id_);
+    H5Fclose(id_);  // once (after a failure the file is in memory: it succeeds)
+    release();
   }
   FileHandle(const FileHandle&) = delete;
   FileHandle& operator=(const FileHandle&) = delete;
@@ -78,40 +88,28 @@ class FileHandle {
     if (id_ < 0) return;
     flush();
     const herr_t result = H5Fclose(id_);
-    id_ = H5I_INVALID_HID;
+    release();
     if (result < 0) throw H5::FileIException("H5Fclose", "closing the file failed");
   }
-  /// Closes a file a write failed in, for good, without crashing. HDF5 1.10
-  /// frees a file whose close failed but keeps its id, and its clean-up at exit
-  /// then crashes on it; so the close must not fail: the file descriptor is
-  /// pointed at an anonymous in-memory file first (memfd), where the flush and
-  /// the truncation at close succeed (a full disk has no say in it; a file-size
-  /// limit is raised to its hard limit meanwhile). The file's contents are lost:
-  /// the caller removes it.
+  /// Closes a file a write failed in (diverted to memory by then, see
+  /// watchForFailure), for good; the caller removes it.
   void abandon() noexcept {
     if (id_ < 0) return;
-    void* handle = nullptr;
-    if (H5Fget_vfd_handle(id_, H5P_DEFAULT, &handle) >= 0 && handle != nullptr) {
-      const int scratch = ::memfd_create("rocklab-abandoned-hdf5", MFD_CLOEXEC);
-      if (scratch >= 0) {
-        ::dup2(scratch, *static_cast<int*>(handle));  // the sec2 driver's handle is its fd
-        ::close(scratch);
-      }
-    }
-    rlimit size{};
-    const bool limited = ::getrlimit(RLIMIT_FSIZE, &size) == 0 && size.rlim_cur < size.rlim_max;
-    if (limited) {
-      const rlimit raised{size.rlim_max, size.rlim_max};
-      ::setrlimit(RLIMIT_FSIZE, &raised);
-    }
     H5Fclose(id_);
-    if (limited) ::setrlimit(RLIMIT_FSIZE, &size);
-    id_ = H5I_INVALID_HID;
+    release();
   }
+  /// "" or why a failure diverted this file to memory (its writes are lost).
+  std::string failure() const { return fd_ != nullptr ? diverted(fd_) : std::string(); }
   bool isOpen() const { return id_ >= 0; }
 
  private:
+  void release() {
+    if (fd_ != nullptr) unwatch(fd_);
+    fd_ = nullptr;
+    id_ = H5I_INVALID_HID;
+  }
   hid_t id_ = H5I_INVALID_HID;
+  int* fd_ = nullptr;  // the driver's descriptor (files on disk), watched while open
   H5::Group root_;
 };
 

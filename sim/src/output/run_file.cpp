@@ -122,6 +122,18 @@ void guarded(const std::filesystem::path& file, const char* what, bool& failed, 
   }
 }
 
+/// The same for a RunFile: also fails when an HDF5 failure elsewhere diverted
+/// the file to memory (detail::watchForFailure), so no write is lost unseen.
+template <class Impl, class Action>
+void guardedWrite(Impl& impl, const char* what, Action&& action) {
+  if (const std::string reason = impl.handle.failure(); !impl.failed && !reason.empty()) {
+    impl.failed = true;  // a close HDF5 does in a destructor failed, unseen until now
+    throw OutputError("run file '" + impl.partial.string() + "': cannot " + what + ": " + reason +
+                      " (an earlier write to it failed)");
+  }
+  guarded(impl.partial, what, impl.failed, std::forward<Action>(action));
+}
+
 }  // namespace
 
 struct RunFile::Impl {
@@ -172,7 +184,7 @@ RunFile::RunFile(const std::filesystem::path& path, const std::string& scene_tex
 
 RunFile::~RunFile() {
   if (!impl_ || !impl_->open) return;
-  if (impl_->failed) {
+  if (failed()) {
     discard();  // a file a write failed in is not a trajectory (the owner should have said so)
     return;
   }
@@ -184,7 +196,7 @@ RunFile::~RunFile() {
 }
 
 bool RunFile::failed() const {
-  return impl_->failed;
+  return impl_->failed || !impl_->handle.failure().empty();
 }
 
 void RunFile::discard() noexcept {
@@ -200,7 +212,7 @@ void RunFile::writeFrame(const Snapshot& snapshot) {
   // The arrays are checked before anything is written.
   if (const auto bad = detail::bondProblem(snapshot, particleCount(snapshot)))
     throw std::invalid_argument("snapshot: " + bondProblemText(*bad));
-  guarded(impl_->partial, "write a frame", impl_->failed, [&] {
+  guardedWrite(*impl_, "write a frame", [&] {
     const H5::Group frame = impl_->file().createGroup(frameGroupName(impl_->frames));
     writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
     writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
@@ -230,7 +242,7 @@ void RunFile::appendEnergy(const Snapshot& snapshot) {
                                                static_cast<double>(snapshot.contacts)};
   // Not flushed here: rows may come every few steps; the next frame's flush
   // (or close) writes them out.
-  guarded(impl_->partial, "append an energy row", impl_->failed, [&] {
+  guardedWrite(*impl_, "append an energy row", [&] {
     const hsize_t r = impl_->energy_rows;
     const std::array<hsize_t, 2> grown{r + 1, kEnergyColumns};
     impl_->energy.extend(grown.data());
@@ -252,7 +264,7 @@ void RunFile::close(bool interrupted) {
   impl_->requireOpen("close");
   if (impl_->failed) throw std::logic_error("RunFile::close after a failed write (discard() it)");
   try {
-    guarded(impl_->partial, "finish it", impl_->failed, [&] {
+    guardedWrite(*impl_, "finish it", [&] {
       setIntAttribute(impl_->file(), "complete", interrupted ? 0 : 1);
       setIntAttribute(impl_->file(), "interrupted", interrupted ? 1 : 0);
       impl_->handle.close();

@@ -18,6 +18,25 @@ struct OutputError : std::runtime_error {
 /// Throws OutputError, e.g. "cannot write 'out/results.json': no space left on device".
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
+/// Disk space set aside when a run starts for a small file written at its end
+/// (results.json): "<path>.partial" is allocated now, so a disk that fills up
+/// during the run still takes the file that says so. Without the space the
+/// reservation is simply not made and write() tries like writeFileAtomically.
+class ReservedFile {
+ public:
+  ReservedFile(std::filesystem::path path, std::size_t bytes);
+  ~ReservedFile();  // removes the reservation if write() did not use it
+  ReservedFile(const ReservedFile&) = delete;
+  ReservedFile& operator=(const ReservedFile&) = delete;
+  /// Writes `bytes` over the reservation (beyond it, as far as the disk allows)
+  /// and renames it to the path; throws OutputError like writeFileAtomically.
+  void write(std::string_view bytes);
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;  // the reserved "<path>.partial", open while unused
+};
+
 /// The system's text for an errno value, starting lower case ("no space left on device").
 std::string systemReason(int errnum);
 
