@@ -3,6 +3,7 @@
 // and row, and nothing written; a write that fails (a full disk) ends the run
 // as failed with exit 1, the file and the reason, leaving the good files.
 #include <H5Cpp.h>
+#include <sys/mount.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -264,4 +265,47 @@ TEST_CASE("a write that fails mid-run (a full disk) ends it as failed: exit 1, t
     CHECK(e.path().extension() != ".tmp");
   }
   fs::remove_all(out);
+}
+
+TEST_CASE("a full disk (a 256 KiB tmpfs, when root): failed, exit 1, 'no space left', results.json written, no temporaries",
+          "[cli]") {
+  // The issue's reproduction on a real full file system. Mounting needs root:
+  // elsewhere this case says so and checks nothing (the RLIMIT case above covers
+  // the failing writes; this one also the space results.json had set aside).
+  const fs::path disk = tempDir("tmpfs");
+  fs::create_directories(disk);
+  if (::geteuid() != 0 || ::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=256k") != 0) {
+    WARN("not run: mounting a tmpfs needs root");
+    fs::remove_all(disk);
+    return;
+  }
+  const fs::path out = disk / "full" / "a";
+  std::fflush(stdout);
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    std::ostringstream quiet;
+    std::cerr.rdbuf(quiet.rdbuf());
+    std::exit(cli({"run", kHopper, "--threads", "1", "--quiet", "--out", out.string(), "--set",
+                   "particles.0.count=200", "--set", "scene.end_time=0.02", "--set", "output.frame_interval=0.0005",
+                   "--set", "output.checkpoint_interval=0.002"}));
+  }
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  CHECK(WIFEXITED(status));
+  CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 1));
+  if (fs::exists(out / "results.json")) {
+    const auto r = nlohmann::json::parse(slurp(out / "results.json"));
+    CHECK(r["status"] == "failed");
+    CHECK_THAT(r["message"].get<std::string>(), Catch::Contains(out.string()) && Catch::Contains("no space left"));
+  } else {
+    FAIL("no results.json");
+  }
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
+    INFO(e.path());
+    CHECK(e.path().extension() != ".partial");
+    CHECK(e.path().extension() != ".tmp");
+  }
+  ::umount(disk.c_str());
+  fs::remove_all(disk);
 }

@@ -31,6 +31,28 @@ bool writeAll(int fd, std::string_view bytes) {
   return true;
 }
 
+/// Writes `bytes` to the open `fd` of `temporary` (from its start, cutting off
+/// anything beyond), closes it and renames it to `path`; on any failure removes
+/// `temporary` and throws OutputError naming `path` and the system's reason.
+void writeAndRename(int fd, const std::filesystem::path& temporary, const std::filesystem::path& path,
+                    std::string_view bytes) {
+  const auto fail = [&](int errnum) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    return OutputError("cannot write '" + path.string() + "': " + systemReason(errnum));
+  };
+  // POSIX calls, not a stream: each failure keeps its errno (a stream's does not).
+  if (!writeAll(fd, bytes) || ::ftruncate(fd, static_cast<off_t>(bytes.size())) != 0) {
+    const int errnum = errno;
+    ::close(fd);
+    throw fail(errnum);
+  }
+  if (::close(fd) != 0) throw fail(errno);
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw fail(error.value());
+}
+
 }  // namespace
 
 ReservedFile::ReservedFile(std::filesystem::path path, std::size_t bytes) : path_(std::move(path)) {
@@ -54,51 +76,16 @@ void ReservedFile::write(std::string_view bytes) {
     writeFileAtomically(path_, bytes);
     return;
   }
-  const std::filesystem::path temporary = path_.string() + ".partial";
   const int fd = fd_;
   fd_ = -1;  // used: whatever happens, it is not removed twice
-  const auto fail = [&](int errnum) {
-    ::close(fd);
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    return OutputError("cannot write '" + path_.string() + "': " + systemReason(errnum));
-  };
-  if (!writeAll(fd, bytes)) throw fail(errno);
-  if (::ftruncate(fd, static_cast<off_t>(bytes.size())) != 0) throw fail(errno);  // the unused rest
-  if (::close(fd) != 0) {
-    const int errnum = errno;
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw OutputError("cannot write '" + path_.string() + "': " + systemReason(errnum));
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path_, error);
-  if (error) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw OutputError("cannot write '" + path_.string() + "': " + systemReason(error.value()));
-  }
+  writeAndRename(fd, path_.string() + ".partial", path_, bytes);
 }
 
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
   const std::filesystem::path temporary = path.string() + ".partial";
-  const auto fail = [&](int errnum) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    return OutputError("cannot write '" + path.string() + "': " + systemReason(errnum));
-  };
-  // POSIX calls, not a stream: each failure keeps its errno (a stream's does not).
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) throw fail(errno);
-  if (!writeAll(fd, bytes)) {
-    const int errnum = errno;
-    ::close(fd);
-    throw fail(errnum);
-  }
-  if (::close(fd) != 0) throw fail(errno);
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw fail(error.value());
+  if (fd < 0) throw OutputError("cannot write '" + path.string() + "': " + systemReason(errno));
+  writeAndRename(fd, temporary, path, bytes);
 }
 
 }  // namespace rocklab::sim::output
