@@ -57,9 +57,6 @@ int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
   return kExitOk;
 }
 
-// The most steps a run counts: t = step dt is exact in a double up to 2^53 steps.
-constexpr double kMaxSteps = 9007199254740992.0;
-
 /// Step counts of the scene's end and of its output intervals at the World's dt;
 /// "" or why the end cannot be counted in steps (an end_time or dt that
 /// overflows the count), naming the keys and their values.
@@ -86,9 +83,7 @@ std::string countSteps(const Scene& scene, double dt, bool restart, RunSetup& se
     setup.total_steps = static_cast<std::uint64_t>(std::llround(steps));
   }
   // An interval longer than the run is never reached: capped, not refused.
-  auto stepsFor = [dt](double interval) -> std::uint64_t {
-    return interval > 0 ? static_cast<std::uint64_t>(std::clamp(std::round(interval / dt), 1.0, kMaxSteps)) : 0;
-  };
+  auto stepsFor = [dt](double interval) -> std::uint64_t { return interval > 0 ? stepsIn(interval, dt) : 0; };
   setup.frame_every = stepsFor(scene.run.frame_interval);
   setup.energy_every = stepsFor(scene.run.energy_interval);
   setup.checkpoint_every = stepsFor(scene.run.checkpoint_interval);
