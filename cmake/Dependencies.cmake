@@ -14,6 +14,7 @@ find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs videoio calib3d
 find_package(VTK 9.1 REQUIRED COMPONENTS IOXML CommonCore CommonDataModel)
 # FindHDF5 picks the serial build even when VTK pulled in the OpenMPI one.
 find_package(HDF5 REQUIRED COMPONENTS C CXX)     # hdf5::hdf5, hdf5::hdf5_cpp
+find_package(ZLIB REQUIRED)                       # ZLIB::ZLIB: crc32 checksums of HDF5 datasets
 find_package(Catch2 2 REQUIRED)                  # Catch2::Catch2
 # Off-screen GL for render/. Never link OpenGL::GL or libGL with it (STACK.md §3).
 find_package(PkgConfig REQUIRED)

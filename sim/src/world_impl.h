@@ -207,6 +207,10 @@ struct World::Impl {
 
   // --- watchdog (stage 7)
   struct Guard {
+    // dt forced above the automatic step (timestep.allow_unsafe): every step
+    // looks for a ball that moved farther than its radius (it can pass through
+    // a wall or a ball unseen) and warns (stats.far_travel_*).
+    bool check_travel = false;
     bool energy_ref_valid = false;
     double energy_ref = 0.0, energy_scale = 0.0;  // J
     // Work done on each ball by moving walls since the energy reference (J), net
@@ -224,7 +228,22 @@ struct World::Impl {
     std::vector<double> wall;  // [k] m, the same for ball–wall candidates
     bool pending = false;      // offsets still to be taken at the first step
     double factor = 0.0;       // offset / initial overlap at this step (1 -> 0, smoothstep)
-    bool active() const { return !pair.empty(); }
+    // Its own flag, not "pair is not empty": a ball on a wall with no ball pair
+    // in the list relaxes too. While on, both arrays match the current lists.
+    bool on = false;
+    bool active() const { return on; }
+    void start(std::size_t pairs, std::size_t walls) {
+      pair.assign(pairs, 0.0);
+      wall.assign(walls, 0.0);
+      on = true;
+    }
+    void stop() {
+      pair.clear();
+      pair.shrink_to_fit();
+      wall.clear();
+      wall.shrink_to_fit();
+      on = false;
+    }
   } relax;
 
   // Below this many balls per thread a second thread does not pay: a step of a
@@ -310,6 +329,7 @@ struct World::Impl {
   void watchdogStage(const StepPlan& plan, const StepChecks& checks);
   void checkOverlap(const StepChecks& checks) const;
   void checkFinite() const;
+  void checkTravel();
   void checkEnergy(const Energy& e);
   bool energyCheckApplies() const;
   void checkNetworkStep();

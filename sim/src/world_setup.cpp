@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "rigid_body.h"
+#include "state_check.h"
 #include "rocklab/sim/wall_motion.h"
 
 namespace rocklab::sim {
@@ -245,9 +246,12 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
   w.model = std::move(model);
   const std::string msg = validateModel(w.model, {});
   if (!msg.empty()) throw std::invalid_argument(msg);
+  // Every value before any is used: an index out of range reads past a table,
+  // a zero radius hangs the neighbour search (the caller names the file).
+  if (const std::string bad = detail::stateProblem(w.model, state); !bad.empty()) throw std::invalid_argument(bad);
   w.p = std::move(state.particles);
   if (const std::string bad = validateBonds(w.model.bonds, w.p, state.bonds); !bad.empty())
-    throw std::invalid_argument("checkpoint: " + bad);
+    throw std::invalid_argument("bonds: " + bad);
   w.bonds.state = std::move(state.bonds);
   w.indexBonds();
   w.time = state.time;
@@ -260,39 +264,37 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
   // Contact history: build the lists now and take the saved shear forces.
   w.prepareStage();
   w.rebuildNeighbours();
-  for (const PairHistory& h : state.pair_history) {
+  for (std::size_t row = 0; row < state.pair_history.size(); ++row) {
+    const PairHistory& h = state.pair_history[row];
     const auto b = w.nb.pairs.partner.begin() + w.nb.pairs.row_offset[h.i];
     const auto e = w.nb.pairs.partner.begin() + w.nb.pairs.row_offset[h.i + 1];
     const auto it = std::lower_bound(b, e, h.j);
     if (it == e || *it != h.j)
-      throw std::invalid_argument("checkpoint: contact history for a pair that is not in contact range");
+      throw std::invalid_argument("pairs row " + std::to_string(row) + ": balls " + std::to_string(h.i) + " and " +
+                                  std::to_string(h.j) + " (allowed: a pair within contact range, as saved)");
     w.history.pair_shear[it - w.nb.pairs.partner.begin()] = h.shear;
     if (h.relax_offset > 0) {
-      if (w.relax.pair.empty()) {
-        w.relax.pair.assign(w.nb.pairs.size(), 0.0);
-        w.relax.wall.assign(w.nb.wall_index.size(), 0.0);
-      }
+      if (!w.relax.active()) w.relax.start(w.nb.pairs.size(), w.nb.wall_index.size());
       w.relax.pair[it - w.nb.pairs.partner.begin()] = h.relax_offset;
     }
   }
-  for (const WallHistory& h : state.wall_history) {
-    if (h.wall >= w.walls.size()) throw std::invalid_argument("checkpoint: wall contact history for a missing wall");
+  for (std::size_t row = 0; row < state.wall_history.size(); ++row) {
+    const WallHistory& h = state.wall_history[row];
     if (!w.walls[h.wall].active) continue;  // the wall was removed: its contacts went with it
     bool found = false;
     for (std::uint32_t c = w.nb.wall_offset[h.particle]; c < w.nb.wall_offset[h.particle + 1]; ++c)
       if (w.nb.wall_index[c] == h.wall) {
         w.history.wall_shear[c] = h.shear;
         if (h.relax_offset > 0) {
-          if (w.relax.pair.empty()) {
-            w.relax.pair.assign(w.nb.pairs.size(), 0.0);
-            w.relax.wall.assign(w.nb.wall_index.size(), 0.0);
-          }
+          if (!w.relax.active()) w.relax.start(w.nb.pairs.size(), w.nb.wall_index.size());
           w.relax.wall[c] = h.relax_offset;
         }
         found = true;
       }
     if (!found)
-      throw std::invalid_argument("checkpoint: wall contact history for a ball out of wall range");
+      throw std::invalid_argument("walls row " + std::to_string(row) + ": ball " + std::to_string(h.particle) +
+                                  " and wall '" + w.model.walls[h.wall].name +
+                                  "' (allowed: a ball within contact range of the wall, as saved)");
   }
 }
 
@@ -300,6 +302,7 @@ World::~World() = default;
 
 void World::Impl::initialise(int requested_threads) {
   threads = requested_threads > 0 ? requested_threads : omp_get_max_threads();
+  guard.check_travel = dt > audit.automatic;  // forced (timestep.allow_unsafe); dt is set by now
   has_clumps = p.clumps.size() > 0;
   buildPairProps();
   walls.resize(model.walls.size());

@@ -1,5 +1,10 @@
 #pragma once
 // Runs the CLI in-process, as `rocklab ARGS...` would: returns the exit code.
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -12,6 +17,24 @@ inline int cli(std::vector<std::string> args) {
   std::vector<const char*> argv;
   for (auto& a : args) argv.push_back(a.c_str());
   return runCli(static_cast<int>(argv.size()), argv.data());
+}
+
+/// The same with what it writes to stderr captured in `log`.
+inline int cliLogged(const std::vector<std::string>& args, std::string& log) {
+  std::ostringstream captured;
+  auto* const old = std::cerr.rdbuf(captured.rdbuf());
+  const int code = cli(args);
+  std::cerr.rdbuf(old);
+  log = captured.str();
+  return code;
+}
+
+/// An empty scratch path "rocklab-<name>-<pid>" in the temporary folder (the pid
+/// keeps two checkouts' suites apart); not created.
+inline std::filesystem::path scratchDir(const std::string& name) {
+  const std::filesystem::path d = std::filesystem::temp_directory_path() / ("rocklab-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  return d;
 }
 
 }  // namespace rocklab::experiments::test

@@ -105,6 +105,32 @@ TEST_CASE("initial overlap 55 % of the radius: stopped at step 0 without relaxat
          "eased apart: fastest " + num(o.max_speed, 3) + " m/s");
 }
 
+TEST_CASE("a lone ball created 30 % into a floor: eased out with relaxation, not shot off", "[stability]") {
+  // No ball pair in the list at all: the wall's offset alone must relax (it was
+  // ignored while only the pair list decided whether a relaxation runs).
+  const double r = kRock, f = 0.3;
+  const int n = 5000;
+  auto fastest = [&](int relax_steps) {
+    sim::Model model = linearPair(1e9);
+    model.walls = {test::floorPlane()};
+    model.relaxation.steps = relax_steps;
+    sim::World w(model, {sphere({0, 0, r - f * r}, r)}, 1);
+    const Outcome o = run(w, static_cast<std::uint64_t>(relax_steps) + 3000, 10);
+    REQUIRE(o.finite);
+    REQUIRE_FALSE(o.stopped);
+    return std::pair{o.max_speed, w.dt()};
+  };
+  const auto [released, dt_released] = fastest(0);
+  const auto [eased, dt] = fastest(n);
+  // The offset shrinks at 1.5 f r / (n dt) at most; the ball follows it.
+  const double rate = 1.5 * f * r / (n * dt);
+  CHECK(eased <= 1.05 * rate);
+  CHECK(released > 100 * eased);
+  figure("a lone ball 0.3 r into a floor", "with relaxation 5000 steps: fastest " + num(eased, 3) +
+                                               " m/s (offset peak rate " + num(rate, 3) + "); without: " +
+                                               num(released, 4) + " m/s");
+}
+
 TEST_CASE("breakage replacement: a 4 mm fragment between two rocks overlapping both by half its radius", "[stability]") {
   // Floor, rock, fragment, rock on one vertical line under gravity; the fragment
   // overlaps each rock by 1 mm (50 % of its radius). Study pebble stiffness 1e9 N/m.

@@ -8,6 +8,19 @@ namespace rocklab::experiments {
 
 using geometry::Vec3;
 
+std::string sceneIndexProblem(const sim::Snapshot& s, const sim::Model& model) {
+  const std::size_t materials = model.materials.size();
+  for (std::size_t i = 0; i < s.material.size(); ++i)
+    if (s.material[i] < 0 || static_cast<std::size_t>(s.material[i]) >= materials)
+      return "material row " + std::to_string(i) + ": " + std::to_string(s.material[i]) + " (allowed: 0 to " +
+             std::to_string(materials - 1) + ", the scene has " + std::to_string(materials) + " materials)";
+  if (s.wall_active.size() > model.walls.size())
+    return "wall_active row " + std::to_string(model.walls.size()) + ": the frame has " +
+           std::to_string(s.wall_active.size()) + " walls (allowed: at most the scene's " +
+           std::to_string(model.walls.size()) + ")";
+  return {};
+}
+
 FrameBuilder::FrameBuilder(const Scene& scene, ColourBy colour_by)
     : looks_(scene.wall_looks), material_colours_(scene.material_colours), colour_by_(colour_by) {
   for (std::size_t k = 0; k < scene.model.walls.size(); ++k) {

@@ -6,6 +6,7 @@
 // or a slab), in its pose at the snapshot's time. The renderer never sees sim types.
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <unordered_set>
 #include <vector>
 
@@ -14,6 +15,12 @@
 #include "rocklab/sim/snapshot.h"
 
 namespace rocklab::experiments {
+
+/// "" or the first index of a snapshot read back from a file that `model`'s
+/// tables do not have, as "<array> row <k>: <value> (allowed: ...)": a material
+/// past the scene's materials, a wall_active longer than its walls. (The file
+/// reader checks the rest: sim::output::RunFileReader::frame.)
+std::string sceneIndexProblem(const sim::Snapshot& s, const sim::Model& model);
 
 class FrameBuilder {
  public:

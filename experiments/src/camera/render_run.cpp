@@ -26,15 +26,28 @@ int renderRun(const RenderRunOptions& o, std::ostream& log) {
       log << "error: " << o.run_file.string() << ": no frames stored (set output.frame_interval when running)\n";
       return kExitBadInput;
     }
+    // The whole file is read and checked before anything is written: a damaged
+    // frame must not leave some stills replaced and the rest old.
+    for (std::size_t k = 0; k < run.frameCount(); ++k)
+      if (const std::string bad = sceneIndexProblem(run.frame(k), scene.model); !bad.empty()) {
+        log << "error: run file '" << o.run_file.string() << "' frame " << k << ": " << bad << "\n";
+        return kExitBadInput;
+      }
     // From results.json beside the run: the markers the chute chose, and where
     // the experiment placed the plane walls (the Zwick platens; its last placement).
     std::unordered_set<std::uint64_t> markers;
-    std::ifstream results(o.run_file.parent_path() / "results.json");
+    const std::filesystem::path results_path = o.run_file.parent_path() / "results.json";
+    std::ifstream results(results_path);
     if (results) {
-      const nlohmann::json r = nlohmann::json::parse(results, nullptr, false);
-      if (r.is_object() && r.contains("markers"))
-        for (const auto& m : r["markers"]) markers.insert(m["id"].get<std::uint64_t>());
-      if (r.is_object() && r.contains("wall_placement")) applyWallPlacement(r["wall_placement"], scene.model);
+      try {
+        const nlohmann::json r = nlohmann::json::parse(results, nullptr, false);
+        if (r.is_object() && r.contains("markers"))
+          for (const auto& m : r["markers"]) markers.insert(m.at("id").get<std::uint64_t>());
+        if (r.is_object() && r.contains("wall_placement")) applyWallPlacement(r["wall_placement"], scene.model);
+      } catch (const std::exception& e) {  // a hand-edited or damaged results.json
+        log << "error: " << results_path.string() << ": " << e.what() << "\n";
+        return kExitBadInput;
+      }
     }
     const std::filesystem::path out = o.out_dir.empty() ? o.run_file.parent_path() : o.out_dir;
     std::filesystem::create_directories(out);

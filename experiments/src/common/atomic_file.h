@@ -1,21 +1,16 @@
 #pragma once
 // Text outputs (results.json, tables) are written to "<path>.partial" and renamed
-// into place, so a half-written file never replaces a good one. Internal.
+// into place, so a half-written file never replaces a good one; a failure throws
+// sim::output::OutputError naming the file and the system's reason. Internal.
 #include <filesystem>
-#include <fstream>
-#include <stdexcept>
 #include <string>
+
+#include "rocklab/sim/output/file_write.h"
 
 namespace rocklab::experiments::detail {
 
 inline void writeAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path tmp = path.string() + ".partial";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  std::filesystem::rename(tmp, path);
+  sim::output::writeFileAtomically(path, text);
 }
 
 }  // namespace rocklab::experiments::detail

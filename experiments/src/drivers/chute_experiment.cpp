@@ -86,8 +86,7 @@ class ChuteExperiment final : public Experiment {
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     if (phase_ == Phase::Start) {
-      every_ =
-          static_cast<std::uint64_t>(std::max(1.0, std::round(e_.sample_interval / world->dt())));
+      every_ = stepsIn(e_.sample_interval, world->dt());
       switchPhase(world, ctx, [&](sim::Model& m) {
         m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
         m.gravity_changes.clear();  // the experiment owns gravity

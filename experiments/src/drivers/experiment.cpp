@@ -1,10 +1,15 @@
 #include "drivers/experiment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
 namespace rocklab::experiments {
+
+std::uint64_t stepsIn(double interval, double dt) {
+  return static_cast<std::uint64_t>(std::clamp(std::round(interval / dt), 1.0, kMaxSteps));
+}
 
 std::unordered_map<std::uint64_t, BodyRef> indexBodies(const sim::ParticleState& p) {
   std::unordered_map<std::uint64_t, BodyRef> bodies;

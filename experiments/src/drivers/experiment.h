@@ -77,4 +77,11 @@ void switchPhase(std::unique_ptr<sim::World>& world, const ExperimentContext& ct
                  const std::function<void(sim::Model&)>& edit,
                  const std::vector<bool>& remove = {});
 
+/// The most steps a run counts: t = step dt is exact in a double up to 2^53.
+inline constexpr double kMaxSteps = 9007199254740992.0;
+
+/// Steps in `interval` s at the step `dt` (at least 1): an interval longer than
+/// any run (more than 2^53 steps) counts as 2^53, never as an overflow.
+std::uint64_t stepsIn(double interval, double dt);
+
 }  // namespace rocklab::experiments

@@ -33,8 +33,7 @@ class HeapExperiment final : public Experiment {
   void cameraFrame(std::uint64_t, double, const cv::Mat& raw) override { photo_ = raw.clone(); }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext&) override {
-    const auto every =
-        static_cast<std::uint64_t>(std::max(1.0, std::round(e_.sample_interval / world->dt())));
+    const std::uint64_t every = stepsIn(e_.sample_interval, world->dt());
     if (world->stepCount() % every != 0) return true;
     const double t = world->time();
     if (!settle_.over(*world)) return true;

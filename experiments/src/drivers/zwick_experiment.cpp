@@ -60,8 +60,7 @@ class ZwickExperiment final : public Experiment {
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     if (sample_every_ == 0)
-      sample_every_ = std::max<std::uint64_t>(
-          1, static_cast<std::uint64_t>(std::llround(s_.sample_interval / world->dt())));
+      sample_every_ = stepsIn(s_.sample_interval, world->dt());
     if (world->stepCount() % sample_every_ != 0) return true;
     if (phase_ == Phase::Settle) {
       collectBreaks(*world);  // a specimen may lose bonds while it settles
@@ -115,8 +114,7 @@ class ZwickExperiment final : public Experiment {
       top.motion.velocity = -s_.platen_speed * up_;
     });
     if (s_.sample_travel > 0)
-      sample_every_ = std::max<std::uint64_t>(
-          1, static_cast<std::uint64_t>(std::llround(s_.sample_travel / s_.platen_speed / world->dt())));
+      sample_every_ = stepsIn(s_.sample_travel / s_.platen_speed, world->dt());
     seen_breaks_ = 0;  // the settling World's log (collected by advance) went with it
     phase_ = Phase::Load;
     total_volume_ = 0;

@@ -25,9 +25,8 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   detail::RunSetup setup;
   if (const int rc = detail::setUpRun(scene, options, log, setup); rc != kExitOk) return rc;
   times.setup_done = detail::Clock::now();
-  const detail::RunRecord record = detail::stepRun(scene, options, log, setup);
-  detail::writeResults(scene, options, setup, record, times, log);
-  return record.exit_code;
+  detail::RunRecord record = detail::stepRun(scene, options, log, setup);
+  return detail::writeResults(scene, options, setup, record, times, log);
 }
 
 }  // namespace rocklab::experiments

@@ -14,6 +14,7 @@
 #include "camera/camera_recorder.h"
 #include "drivers/experiment.h"
 #include "rocklab/experiments/run.h"
+#include "rocklab/sim/output/file_write.h"
 #include "rocklab/sim/output/run_file.h"
 #include "rocklab/sim/output/vtk_series.h"
 #include "rocklab/sim/world.h"
@@ -34,6 +35,9 @@ struct RunSetup {
   std::vector<std::unique_ptr<CameraRecorder>> cameras;
   std::unique_ptr<sim::output::RunFile> run_file;  // null without output.hdf5
   std::unique_ptr<sim::output::VtkSeries> vtk;     // null without output.vtk
+  // Space for results.json set aside at the start: a disk that fills up during
+  // the run still takes the file that says the run failed.
+  std::unique_ptr<sim::output::ReservedFile> results_file;
   double dt = 0.0;  // s, of the first World: the step counts below are made with it
   std::uint64_t total_steps = 0;
   // Steps between trajectory frames, energy rows and checkpoints (0 = none).
@@ -42,7 +46,8 @@ struct RunSetup {
 
 /// Builds the World (new, or from options.restart), the experiment, the cameras
 /// and the output writers, and logs the set-up. Returns kExitOk, or
-/// kExitBadInput with the reason in `log` (then nothing was written).
+/// kExitBadInput with the reason in `log` (then nothing was written), or
+/// kExitFailed when an output file cannot be created (a full disk).
 int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup);
 
 /// How the stepping ended and what it counted, for results.json.
@@ -50,6 +55,21 @@ struct RunRecord {
   std::string status = "completed";
   std::string message;  // why it stopped early ("" when completed or interrupted)
   int exit_code = kExitOk;
+  /// An output failed after the stepping stopped (a full disk): a completed or
+  /// interrupted run becomes failed; a run already stopped keeps its status and
+  /// adds the reason.
+  void outputFailed(const std::string& reason) {
+    if (message.find(reason) != std::string::npos) return;  // the same output failing again
+    if (status == "completed" || status == "interrupted") {
+      status = "failed";
+      exit_code = kExitFailed;
+      message = reason;
+    } else {
+      message += (message.empty() ? "" : "; ") + reason;
+    }
+  }
+  bool run_file_kept = false;           // run.h5 finished and in place
+  std::int64_t checkpoint_step = -1;    // step of the last checkpoint written, -1 none
   bool experiment_over = false;  // the experiment ended the run
   sim::Snapshot last;            // time, step, energy and contacts of the last observed step
   std::size_t frames = 0;        // trajectory frames written
@@ -60,6 +80,10 @@ struct RunRecord {
   double network_ratio = 0.0;
   std::uint64_t network_checks = 0;
   std::array<double, sim::kStageCount> stage_seconds{};
+  // Steps in which a ball moved farther than its radius (dt forced above the
+  // automatic step only: sim::WorldStats) and the first of them described.
+  std::uint64_t far_travel_steps = 0;
+  std::string far_travel;
   double output_seconds = 0.0;  // s spent writing outputs
   Clock::time_point loop_start, loop_end;
 };
@@ -76,8 +100,9 @@ struct RunTimes {
 };
 
 /// results.json (with the cameras' and the experiment's reports, which also
-/// write their own files) and the closing log lines.
-void writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup,
-                  const RunRecord& record, const RunTimes& times, std::ostream& log);
+/// write their own files) and the closing log lines. A report or results.json
+/// that cannot be written (a full disk) fails the run; returns its exit code.
+int writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup, RunRecord& record,
+                 const RunTimes& times, std::ostream& log);
 
 }  // namespace rocklab::experiments::detail

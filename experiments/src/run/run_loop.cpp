@@ -67,22 +67,30 @@ class Progress {
 /// new World before the old one goes, so a new address is a new World.
 class WorldStatsSum {
  public:
-  void after(const sim::World& world, RunRecord& record) {
+  /// Returns true when the World warned for the first time in the run (record.far_travel).
+  bool after(const sim::World& world, RunRecord& record) {
     if (&world != seen_) {  // a new World (phase)
       checks_before_ += checks_seen_;
+      far_before_ += far_seen_;
       for (std::size_t s = 0; s < sim::kStageCount; ++s) stages_before_[s] += stages_seen_[s];
       seen_ = &world;
     }
-    checks_seen_ = world.stats().network_checks;
-    stages_seen_ = world.stats().stage_seconds;
-    record.network_ratio = std::max(record.network_ratio, world.stats().network_step_ratio);
+    const sim::WorldStats& stats = world.stats();
+    checks_seen_ = stats.network_checks;
+    far_seen_ = stats.far_travel_steps;
+    stages_seen_ = stats.stage_seconds;
+    record.network_ratio = std::max(record.network_ratio, stats.network_step_ratio);
     record.network_checks = checks_before_ + checks_seen_;
+    record.far_travel_steps = far_before_ + far_seen_;
     for (std::size_t s = 0; s < sim::kStageCount; ++s)
       record.stage_seconds[s] = stages_before_[s] + stages_seen_[s];
+    if (!record.far_travel.empty() || stats.far_travel.empty()) return false;
+    record.far_travel = stats.far_travel;
+    return true;
   }
 
  private:
-  std::uint64_t checks_before_ = 0, checks_seen_ = 0;
+  std::uint64_t checks_before_ = 0, checks_seen_ = 0, far_before_ = 0, far_seen_ = 0;
   std::array<double, sim::kStageCount> stages_before_{}, stages_seen_{};
   const sim::World* seen_ = nullptr;
 };
@@ -115,9 +123,10 @@ class RunLoop {
       // full disk): stop with the reason instead of aborting; outputs so far are kept.
       stopWith("failed", e.what(), kExitFailed);
     }
-    record_.loop_end = Clock::now();
     progress_.finish();
     finishOutputs();
+    // After the last outputs: their time is in output_seconds, so it must be in the loop too.
+    record_.loop_end = Clock::now();
     return record_;
   }
 
@@ -137,7 +146,7 @@ class RunLoop {
       world_->step([this](const sim::Snapshot& s) { observe(s); });
     else
       world_->step();
-    stats_.after(*world_, record_);
+    if (stats_.after(*world_, record_)) *context_.log << "warning: " << record_.far_travel << "\n";
     const std::uint64_t done = world_->stepCount();
     if (setup_.checkpoint_every && done % setup_.checkpoint_every == 0) writeCheckpoint();
     progress_.update(done, experiment ? experiment->progress() : "");
@@ -192,16 +201,41 @@ class RunLoop {
     const auto t0 = Clock::now();
     sim::output::writeCheckpoint(options_.out_dir / "checkpoint.h5", world_->exportState(),
                                  scene_.text);
+    record_.checkpoint_step = static_cast<std::int64_t>(world_->stepCount());
     record_.output_seconds += seconds(t0, Clock::now());
   }
 
-  /// The last checkpoint (a blown-up state is no place to restart from) and run.h5 closed.
+  /// The last checkpoint (a blown-up state is no place to restart from) and run.h5
+  /// closed, each on its own: an output that fails (a full disk) fails the run
+  /// with its reason, and the others are still tried. A run.h5 a write failed in
+  /// is removed first (it cannot be finished; its space may let the checkpoint fit).
   void finishOutputs() {
-    if (record_.exit_code != kExitWatchdog) writeCheckpoint();
     const auto t0 = Clock::now();
-    if (setup_.run_file) setup_.run_file->close(record_.exit_code != kExitOk);
+    sim::output::RunFile* run_file = setup_.run_file.get();
+    const bool run_file_failed = run_file && run_file->failed();
+    if (run_file_failed) {
+      run_file->discard();
+      const std::string partial = (options_.out_dir / "run.h5.partial").string();
+      if (record_.message.find(partial) == std::string::npos)
+        record_.outputFailed("run file '" + partial + "': a write to it failed; removed");
+    }
+    if (record_.exit_code != kExitWatchdog) guardOutput([&] { writeCheckpoint(); });
+    if (run_file && !run_file_failed)
+      guardOutput([&] {
+        run_file->close(record_.exit_code != kExitOk);
+        record_.run_file_kept = true;
+      });
     record_.vtk_frames = setup_.vtk ? setup_.vtk->frameCount() : 0;
     record_.output_seconds += seconds(t0, Clock::now());
+  }
+
+  template <class Output>
+  void guardOutput(Output&& output) {
+    try {
+      output();
+    } catch (const std::exception& e) {
+      record_.outputFailed(e.what());
+    }
   }
 
   void stopWith(const std::string& status, const std::string& message, int exit_code) {

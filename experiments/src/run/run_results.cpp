@@ -9,7 +9,6 @@
 #include <sstream>
 
 #include "camera/wall_placement.h"
-#include "common/atomic_file.h"
 #include "common/json_text.h"
 #include "run/run_internal.h"
 
@@ -85,9 +84,18 @@ json lastObservedJson(const sim::Snapshot& last) {
             {"elastic", last.energy.elastic}}}};
 }
 
-/// s of stepping: the loop less the time it spent writing outputs.
+/// s of stepping: the loop (its last outputs included) less the time it spent
+/// writing outputs; never below 0 (a clock's tick on a run of a few steps).
 double steppingSeconds(const RunRecord& record) {
-  return seconds(record.loop_start, record.loop_end) - record.output_seconds;
+  return std::max(0.0, seconds(record.loop_start, record.loop_end) - record.output_seconds);
+}
+
+/// What the run did that makes its results doubtful without stopping it.
+json warningsJson(const RunRecord& record) {
+  json list = json::array();
+  if (!record.far_travel.empty())
+    list.push_back(record.far_travel + " (" + std::to_string(record.far_travel_steps) + " such steps in all)");
+  return list;
 }
 
 /// The figures of the World and the run, before the cameras and the experiment add theirs.
@@ -99,6 +107,7 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["scene"] = scene.run.name;
   r["status"] = record.status;
   if (!record.message.empty()) r["message"] = record.message;
+  r["warnings"] = warningsJson(record);
   r["particles"] = world.particles().size();
   r["clumps"] = world.particles().clumps.size();
   if (!scene.clump_shapes.empty()) r["clump_shapes"] = clumpShapesJson(scene.clump_shapes);
@@ -125,11 +134,13 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["last_observed"] = lastObservedJson(record.last);
   r["state_hash"] = hex(world.stateHash());
   r["peak_rss_bytes"] = peakRssBytes();
-  const bool checkpoint = scene.run.checkpoint && record.exit_code != kExitWatchdog;
-  r["outputs"] = {{"run_h5", scene.run.hdf5 ? "run.h5" : ""},
+  // What this run left: run.h5 only when it was finished (a failed write removes
+  // it); checkpoint.h5 of the step it holds (an earlier one when the last failed).
+  r["outputs"] = {{"run_h5", record.run_file_kept ? "run.h5" : ""},
                   {"frames", record.frames},
                   {"vtk_frames", record.vtk_frames},
-                  {"checkpoint", checkpoint ? "checkpoint.h5" : ""}};
+                  {"checkpoint", record.checkpoint_step >= 0 ? "checkpoint.h5" : ""}};
+  if (record.checkpoint_step >= 0) r["outputs"]["checkpoint_step"] = record.checkpoint_step;
   return r;
 }
 
@@ -162,12 +173,23 @@ void reportExperiment(const Scene& scene, const RunOptions& options, RunSetup& s
 
 }  // namespace
 
-void writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup,
-                  const RunRecord& record, const RunTimes& times, std::ostream& log) {
+int writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup, RunRecord& record,
+                 const RunTimes& times, std::ostream& log) {
   json r = runJson(scene, setup, record, times);
-  reportCameras(setup, times, r, log);
-  reportExperiment(scene, options, setup, record, r, log);
-  writeAtomically(options.out_dir / "results.json", jsonText(r));
+  try {
+    reportCameras(setup, times, r, log);
+    reportExperiment(scene, options, setup, record, r, log);
+  } catch (const std::exception& e) {  // a movie, plot or table it could not write (a full disk)
+    record.outputFailed(e.what());
+    r["status"] = record.status;
+    r["message"] = record.message;
+  }
+  try {
+    setup.results_file->write(jsonText(r));
+  } catch (const std::exception& e) {
+    log << "error: " << e.what() << "\n";
+    if (record.exit_code == kExitOk) record.exit_code = kExitFailed;
+  }
 
   if (!record.message.empty()) log << "error: " << record.message << "\n";
   const sim::World& world = *setup.world;
@@ -177,6 +199,7 @@ void writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup
       << steppingSeconds(record) << " s, " << std::scientific << std::setprecision(3)
       << r["particle_steps_per_s"].get<double>() << " particle-steps/s); results in "
       << (options.out_dir / "results.json").string() << "\n";
+  return record.exit_code;
 }
 
 }  // namespace rocklab::experiments::detail

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ostream>
+#include <sstream>
 
 #include "rocklab/sim/output/checkpoint.h"
 #include "run/output_folder.h"
@@ -14,20 +15,41 @@ namespace {
 
 namespace out = sim::output;
 
-/// The World at t = 0 from the scene, or where options.restart left it.
-int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
-              std::unique_ptr<sim::World>& world) {
+/// The World where the checkpoint options.restart left it; every value of the
+/// file is checked (World(Model, WorldState)) and a complaint names the file.
+int restartWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
+                 std::unique_ptr<sim::World>& world) {
+  const std::string file = "checkpoint '" + options.restart.string() + "': ";
   try {
-    if (!options.restart.empty()) {
-      out::Checkpoint cp = out::readCheckpoint(options.restart);
-      world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
-    } else {
-      world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, scene.bonds,
-                                           options.threads);
-    }
+    out::Checkpoint cp = out::readCheckpoint(options.restart);
+    if (cp.unchecked > 0)
+      log << "warning: " << file << cp.unchecked
+          << " datasets have no checksum (written before rocklab stored them): read unchecked\n";
+    world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
   } catch (const out::CheckpointError& e) {
     log << "error: " << e.what() << "\n";
     return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    log << "error: " << file << e.what() << "\n";
+    return kExitBadInput;
+  }
+  // The saved step against the scene's stable one: a larger dt than this scene
+  // allows (a damaged value, or stiffer contacts set for the restart) blows up.
+  const sim::TimestepAudit& audit = world->timestepAudit();
+  if (!scene.model.timestep.allow_unsafe && world->dt() > audit.automatic * (1 + 1e-12)) {
+    log << "error: " << file << "attribute dt: " << world->dt() << " s (allowed: > 0 s, at most the automatic step "
+        << audit.automatic << " s of the scene as restarted, or timestep.allow_unsafe = true)\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+/// The World at t = 0 from the scene, or where options.restart left it.
+int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
+              std::unique_ptr<sim::World>& world) {
+  if (!options.restart.empty()) return restartWorld(scene, options, log, world);
+  try {
+    world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, scene.bonds, options.threads);
   } catch (const std::invalid_argument& e) {
     log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string())
         << ": " << e.what() << "\n";
@@ -36,20 +58,37 @@ int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
   return kExitOk;
 }
 
-/// Step counts of the scene's end and of its output intervals at the World's dt.
-void countSteps(const Scene& scene, double dt, RunSetup& setup) {
+/// Step counts of the scene's end and of its output intervals at the World's dt;
+/// "" or why the end cannot be counted in steps (an end_time or dt that
+/// overflows the count), naming the keys and their values.
+std::string countSteps(const Scene& scene, double dt, bool restart, RunSetup& setup) {
   setup.dt = dt;
-  setup.total_steps = scene.run.steps > 0
-                          ? scene.run.steps
-                          : static_cast<std::uint64_t>(std::llround(scene.run.end_time / dt));
-  auto stepsFor = [dt](double interval) -> std::uint64_t {
-    return interval > 0
-               ? std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(interval / dt)))
-               : 0;
-  };
+  std::ostringstream e;
+  if (scene.run.steps > 0) {
+    if (static_cast<double>(scene.run.steps) > kMaxSteps) {
+      e << "scene.steps = " << scene.run.steps << ": more than 2^53 = 9.007e15, the most steps a run counts";
+      return e.str();
+    }
+    setup.total_steps = scene.run.steps;
+  } else {
+    const double steps = scene.run.end_time / dt;
+    if (!(steps <= kMaxSteps)) {
+      e << "scene.end_time = " << scene.run.end_time << " s is " << steps << " steps of dt = " << dt << " s ("
+        << (restart                      ? "the checkpoint's step"
+            : scene.model.timestep.dt > 0 ? "timestep.dt"
+                                          : "the automatic step")
+        << "): more than 2^53 = 9.007e15, the most steps a run counts; lower scene.end_time"
+        << (!restart && scene.model.timestep.dt > 0 ? " or raise timestep.dt" : "");
+      return e.str();
+    }
+    setup.total_steps = static_cast<std::uint64_t>(std::llround(steps));
+  }
+  // An interval longer than the run is never reached: capped, not refused.
+  auto stepsFor = [dt](double interval) -> std::uint64_t { return interval > 0 ? stepsIn(interval, dt) : 0; };
   setup.frame_every = stepsFor(scene.run.frame_interval);
   setup.energy_every = stepsFor(scene.run.energy_interval);
   setup.checkpoint_every = stepsFor(scene.run.checkpoint_interval);
+  return {};
 }
 
 /// Active modules: what this scene constructs (and so pays for), for the log and results.json.
@@ -144,11 +183,16 @@ int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, R
            "saved); run the scene again\n";
     return kExitBadInput;
   }
-  countSteps(scene, setup.world->dt(), setup);
+  if (const std::string bad = countSteps(scene, setup.world->dt(), !options.restart.empty(), setup); !bad.empty()) {
+    log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string()) << ": " << bad << "\n";
+    return kExitBadInput;
+  }
   if (const int rc = prepareOutputFolder(options, log); rc != kExitOk) return rc;
   setup.modules = activeModules(scene, *setup.world, setup.experiment != nullptr);
   logSetup(scene, setup, options, log);
   if (const int rc = makeCameras(scene, options, log, setup); rc != kExitOk) return rc;
+  // 64 KiB: a plain run's results.json takes 5, an experiment's a few tens.
+  setup.results_file = std::make_unique<out::ReservedFile>(options.out_dir / "results.json", 64 * 1024);
   try {
     if (scene.run.hdf5)
       setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);

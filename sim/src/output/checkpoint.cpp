@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "hdf5_io.h"
+#include "rocklab/sim/output/file_write.h"
+#include "state_check.h"
 
 namespace rocklab::sim::output {
 namespace {
@@ -47,69 +49,8 @@ std::string describe(const H5::Exception& e) {
   return "HDF5 error in " + e.getFuncName() + ": " + e.getDetailMsg();
 }
 
-/// Returns "" or what makes the state unusable (array sizes that disagree,
-/// history that refers to missing particles).
-std::string inconsistency(const WorldState& state) {
-  const ParticleState& p = state.particles;
-  const std::size_t n = p.size();
-#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, p.name.size()},
-  const std::pair<const char*, std::size_t> sizes[] = {ROCKLAB_BALL_FIELDS(ROCKLAB_SIZE)};
-#undef ROCKLAB_SIZE
-  for (const auto& [name, size] : sizes) {
-    if (size != n) {
-      return "inconsistent array sizes: particles/" + std::string(name) + " has " +
-             std::to_string(size) + " entries but particles/position has " + std::to_string(n);
-    }
-  }
-  const ClumpState& k = p.clumps;
-  const std::size_t nc = k.size();
-#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, k.name.size()},
-  const std::pair<const char*, std::size_t> clump_sizes[] = {ROCKLAB_CLUMP_FIELDS(ROCKLAB_SIZE)};
-#undef ROCKLAB_SIZE
-  for (const auto& [name, size] : clump_sizes) {
-    if (size != nc) {
-      return "inconsistent array sizes: clumps/" + std::string(name) + " has " + std::to_string(size) +
-             " entries but clumps/position has " + std::to_string(nc);
-    }
-  }
-  if (nc > 0) {
-    if (p.clump.size() != n) return "particles/clump must have one entry per particle";
-    if (k.member_begin.size() != nc + 1 || k.member_begin.back() != k.member_ball.size() ||
-        k.member_offset.size() != k.member_ball.size())
-      return "inconsistent clump member arrays";
-    for (std::uint32_t b : k.member_ball)
-      if (b >= n) return "a clump member refers to particle " + std::to_string(b) + " of " + std::to_string(n);
-  }
-  for (const PairHistory& h : state.pair_history) {
-    if (h.i >= n || h.j >= n) {
-      return "pair history refers to particle pair (" + std::to_string(h.i) + ", " +
-             std::to_string(h.j) + ") but there are " + std::to_string(n) + " particles";
-    }
-  }
-  const BondState& b = state.bonds;
-#define ROCKLAB_SIZE(type, name, unit, meaning) {#name, b.name.size()},
-  const std::pair<const char*, std::size_t> bond_sizes[] = {ROCKLAB_BOND_FIELDS(ROCKLAB_SIZE)};
-#undef ROCKLAB_SIZE
-  for (const auto& [name, size] : bond_sizes) {
-    if (size != b.size()) {
-      return "inconsistent array sizes: bonds/" + std::string(name) + " has " + std::to_string(size) +
-             " entries but bonds/a has " + std::to_string(b.size());
-    }
-  }
-  for (std::size_t e = 0; e < b.size(); ++e) {
-    if (b.a[e] >= n || b.b[e] >= n) {
-      return "bond " + std::to_string(e) + " joins balls (" + std::to_string(b.a[e]) + ", " +
-             std::to_string(b.b[e]) + ") but there are " + std::to_string(n) + " particles";
-    }
-  }
-  for (const WallHistory& h : state.wall_history) {
-    if (h.particle >= n) {
-      return "wall history refers to particle " + std::to_string(h.particle) + " but there are " +
-             std::to_string(n) + " particles";
-    }
-  }
-  return {};
-}
+/// "" or what makes the state's arrays unusable together (state_check.h).
+std::string inconsistency(const WorldState& state) { return sim::detail::stateShapeProblem(state); }
 
 // ---------------------------------------------------------------- writing
 
@@ -161,22 +102,40 @@ void writeBonds(const H5::Group& root, const BondState& b) {
 #undef ROCKLAB_WRITE
 }
 
-void writeFile(const std::filesystem::path& path, const WorldState& state,
-               const std::string& scene_text) {
-  H5::H5File file(path.string(), H5F_ACC_TRUNC);
+/// The run attributes (time, step, dt, half_kick_pending) as one block of bytes,
+/// for their checksum (the datasets carry their own).
+struct RunScalars {
+  double time;
+  std::uint64_t step;
+  double dt;
+  std::int32_t half_kick_pending;
+  std::int32_t zero = 0;  // padding with a known value
+};
+static_assert(sizeof(RunScalars) == 32);
+std::uint32_t runScalarsChecksum(const RunScalars& r) { return detail::checksum(&r, sizeof r); }
+constexpr const char* kRunChecksum = "run_crc32";
+
+/// The checkpoint file's bytes, built in memory: HDF5 never meets the disk, so
+/// a full disk is one failed write() with its errno (writeFileAtomically).
+std::string fileImage(const std::string& name, const WorldState& state, const std::string& scene_text) {
+  detail::FileHandle handle(name, true);
+  const H5::Group& file = handle.root();
   writeTextAttribute(file, "format", kFormat);
   writeScalarAttribute(file, "version", H5::PredType::NATIVE_INT, kFormatVersion);
-  writeScalarAttribute(file, "time", H5::PredType::NATIVE_DOUBLE, state.time);
-  writeScalarAttribute(file, "step", H5::PredType::NATIVE_UINT64, state.step);
-  writeScalarAttribute(file, "dt", H5::PredType::NATIVE_DOUBLE, state.dt);
-  writeScalarAttribute(file, "half_kick_pending", H5::PredType::NATIVE_INT,
-                       state.half_kick_pending ? 1 : 0);
+  const RunScalars run{state.time, state.step, state.dt, state.half_kick_pending ? 1 : 0};
+  writeScalarAttribute(file, "time", H5::PredType::NATIVE_DOUBLE, run.time);
+  writeScalarAttribute(file, "step", H5::PredType::NATIVE_UINT64, run.step);
+  writeScalarAttribute(file, "dt", H5::PredType::NATIVE_DOUBLE, run.dt);
+  writeScalarAttribute(file, "half_kick_pending", H5::PredType::NATIVE_INT, run.half_kick_pending);
+  writeScalarAttribute(file, kRunChecksum, H5::PredType::NATIVE_UINT32, runScalarsChecksum(run));
   writeText(file, "scene", scene_text);
   writeParticles(file, state.particles);
   writeHistory(file, kPairLayout, state.pair_history);
   writeHistory(file, kWallLayout, state.wall_history);
   writeBonds(file, state.bonds);
-  file.close();
+  std::string image = handle.image();
+  handle.close();
+  return image;
 }
 
 // ---------------------------------------------------------------- reading
@@ -210,15 +169,11 @@ class Reader {
 
   template <class T>
   T attribute(const char* name) const {
-    if (!file_.attrExists(name)) fail(std::string("missing attribute '") + name + "'");
-    const H5::Attribute stored = file_.openAttribute(name);
-    // A scalar is read into one T: a larger attribute would overrun it.
-    if (points(stored.getSpace()) != 1) {
-      fail(std::string("attribute '") + name + "' is not a scalar");
+    try {
+      return detail::readScalarAttribute<T>(file_, name, nativeScalarType<T>());
+    } catch (const std::runtime_error& e) {  // missing, or not one value
+      fail(e.what());
     }
-    T value{};
-    stored.read(nativeScalarType<T>(), &value);
-    return value;
   }
 
   bool has(const std::string& name) const { return file_.nameExists(name); }
@@ -230,8 +185,27 @@ class Reader {
     }
     std::string value;
     dataset.read(value, dataset.getStrType());
+    verify(name, dataset, value.data(), value.size());
     return value;
   }
+
+  /// The run attributes against their checksum (run_crc32; absent in old files).
+  void verifyRunScalars(const RunScalars& run) const {
+    const detail::ChecksumCheck c = [&] {
+      detail::ChecksumCheck check;
+      if (!file_.attrExists(kRunChecksum)) return check;
+      check.present = true;
+      check.stored = attribute<std::uint32_t>(kRunChecksum);
+      check.computed = runScalarsChecksum(run);
+      check.matches = check.stored == check.computed;
+      return check;
+    }();
+    if (!c.present) ++unchecked_;
+    if (!c.matches) fail("attributes time, step, dt, half_kick_pending: " + c.mismatch());
+  }
+
+  /// Datasets (and attribute blocks) read without a checksum to check them by.
+  std::size_t unchecked() const { return unchecked_; }
 
   /// Reads a dataset of shape [n] or [n,3] (as Layout<T> says) into a vector.
   template <class T>
@@ -250,10 +224,17 @@ class Reader {
     }
     std::vector<T> values(dims[0]);
     if (!values.empty()) dataset.read(values.data(), Layout<T>::type());
+    verify(name, dataset, values.data(), values.size() * sizeof(T));
     return values;
   }
 
  private:
+  void verify(const std::string& name, const H5::DataSet& dataset, const void* data, std::size_t bytes) const {
+    const detail::ChecksumCheck c = detail::verifyChecksum(dataset, data, bytes);
+    if (!c.present) ++unchecked_;
+    if (!c.matches) fail("dataset " + name + ": " + c.mismatch());
+  }
+
   static hssize_t points(const H5::DataSpace& space) { return space.getSimpleExtentNpoints(); }
 
   template <class T>
@@ -280,6 +261,7 @@ class Reader {
 
   std::filesystem::path path_;
   H5::H5File file_;
+  mutable std::size_t unchecked_ = 0;
 };
 
 template <class History>
@@ -350,12 +332,17 @@ Checkpoint readFile(const Reader& in) {
   state.time = in.attribute<double>("time");
   state.step = in.attribute<std::uint64_t>("step");
   state.dt = in.attribute<double>("dt");
-  state.half_kick_pending = in.attribute<int>("half_kick_pending") != 0;
+  const int half_kick = in.attribute<int>("half_kick_pending");
+  if (half_kick != 0 && half_kick != 1)
+    in.fail("attribute half_kick_pending: " + std::to_string(half_kick) + " (allowed: 0, 1)");
+  state.half_kick_pending = half_kick == 1;
+  in.verifyRunScalars({state.time, state.step, state.dt, half_kick});
   state.particles = readParticles(in);
   state.pair_history = readHistory(in, kPairLayout);
   state.wall_history = readHistory(in, kWallLayout);
   state.bonds = readBonds(in);
   if (const std::string problem = inconsistency(state); !problem.empty()) in.fail(problem);
+  checkpoint.unchecked = in.unchecked();
   return checkpoint;
 }
 
@@ -363,29 +350,23 @@ Checkpoint readFile(const Reader& in) {
 
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
                      const std::string& scene_text) {
-  H5::Exception::dontPrint();  // errors reach the caller as exceptions instead
-  const auto fail = [&](const std::string& what) {
-    return CheckpointError("cannot write checkpoint " + quoted(path) + ": " + what);
-  };
-  if (const std::string problem = inconsistency(state); !problem.empty()) throw fail(problem);
+  detail::recordHdf5Errors();  // errors reach the caller as exceptions, with the system's reason
+  const std::string what = "cannot write checkpoint " + quoted(path) + ": ";
+  if (const std::string problem = inconsistency(state); !problem.empty()) throw CheckpointError(what + problem);
+  // A write that fails (a full disk) is an OutputError: the state was fine.
+  const auto fail = [&](const std::string& reason) { return OutputError(what + reason); };
 
+  std::string image;
+  try {
+    image = fileImage(path.string(), state, scene_text);
+  } catch (const H5::Exception& e) {
+    throw fail(detail::hdf5Failure(e));
+  }
   // Written beside the target and renamed over it, so an existing checkpoint is
   // replaced in one step and a crash never leaves a half-written one.
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
   std::error_code error;
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), error);
-  try {
-    writeFile(temporary, state, scene_text);
-  } catch (const H5::Exception& e) {
-    std::filesystem::remove(temporary, error);
-    throw fail(describe(e));
-  }
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    throw fail("cannot rename " + quoted(temporary) + ": " + error.message());
-  }
+  writeFileAtomically(path, image);  // OutputError names the file and the reason
 }
 
 Checkpoint readCheckpoint(const std::filesystem::path& path) {

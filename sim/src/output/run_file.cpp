@@ -3,6 +3,7 @@
 #include <H5Cpp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <utility>
 
 #include "hdf5_io.h"
+#include "rocklab/sim/output/file_write.h"
 #include "snapshot_check.h"
 
 namespace rocklab::sim::output {
@@ -83,7 +85,7 @@ constexpr const char* kPerFileGroup = "bonds";
 /// a later frame whose values differ from those (balls removed and the bonds
 /// renumbered) carries its own copy. `written` holds what /bonds has.
 template <class T>
-void writeOncePerFile(const H5::H5File& file, const H5::Group& frame, const char* name,
+void writeOncePerFile(const H5::Group& file, const H5::Group& frame, const char* name,
                       std::span<const T> values, const char* unit, std::vector<T>& written) {
   if (values.empty()) return;
   if (written.empty()) {
@@ -97,7 +99,7 @@ void writeOncePerFile(const H5::H5File& file, const H5::Group& frame, const char
   }
 }
 
-std::string bondProblemText(const detail::BondProblem& p) {
+std::string bondProblemText(const detail::ArrayProblem& p) {
   return std::string(p.array) + " row " + std::to_string(p.row) + ": " + p.what;
 }
 
@@ -107,15 +109,29 @@ std::string frameGroupName(std::size_t frame) {
   return name;
 }
 
-/// Runs an HDF5 action and turns its exception into one that names the file.
+/// Runs an HDF5 action and turns its exception into one that names the file and
+/// the system's reason ("no space left on device"); `failed` is set then.
 template <class Action>
-void guarded(const std::filesystem::path& file, const char* what, Action&& action) {
+void guarded(const std::filesystem::path& file, const char* what, bool& failed, Action&& action) {
+  detail::recordHdf5Errors();
   try {
     std::forward<Action>(action)();
   } catch (const H5::Exception& e) {
-    throw std::runtime_error("run file '" + file.string() + "': cannot " + what + " (" +
-                             e.getFuncName() + ": " + e.getDetailMsg() + ")");
+    failed = true;
+    throw OutputError("run file '" + file.string() + "': cannot " + what + ": " + detail::hdf5Failure(e));
   }
+}
+
+/// The same for a RunFile: also fails when an HDF5 failure elsewhere diverted
+/// the file to memory (detail::watchForFailure), so no write is lost unseen.
+template <class Impl, class Action>
+void guardedWrite(Impl& impl, const char* what, Action&& action) {
+  if (const std::string reason = impl.handle.failure(); !impl.failed && !reason.empty()) {
+    impl.failed = true;  // a close HDF5 does in a destructor failed, unseen until now
+    throw OutputError("run file '" + impl.partial.string() + "': cannot " + what + ": " + reason +
+                      " (an earlier write to it failed)");
+  }
+  guarded(impl.partial, what, impl.failed, std::forward<Action>(action));
 }
 
 }  // namespace
@@ -123,9 +139,8 @@ void guarded(const std::filesystem::path& file, const char* what, Action&& actio
 struct RunFile::Impl {
   Impl(std::filesystem::path final_path, std::filesystem::path partial_path,
        const std::string& scene_text)
-      : path(std::move(final_path)),
-        partial(std::move(partial_path)),
-        file(partial.string(), H5F_ACC_TRUNC) {
+      : path(std::move(final_path)), partial(std::move(partial_path)), handle(partial.string(), false) {
+    const H5::Group& file = handle.root();
     writeTextAttribute(file, "format", "rocklab-run");
     writeScalarAttribute(file, "version", H5::PredType::NATIVE_INT, kFormatVersion);
     // Both stay 0 until close(): a .partial left by a killed run reads as neither.
@@ -134,8 +149,9 @@ struct RunFile::Impl {
     writeText(file, "scene", scene_text);
     file.createGroup("frames");
     energy = createEnergyTable(file);
-    file.flush(H5F_SCOPE_GLOBAL);
+    handle.flush();
   }
+  const H5::Group& file() const { return handle.root(); }
 
   void requireOpen(const char* operation) const {
     if (!open) throw std::logic_error("RunFile::" + std::string(operation) + " after close()");
@@ -143,29 +159,52 @@ struct RunFile::Impl {
 
   std::filesystem::path path;     // the finished file, created by close()
   std::filesystem::path partial;  // `<path>.partial`, written while the run goes on
-  H5::H5File file;
+  detail::FileHandle handle;  // closed once (a full disk must not crash a second close)
   H5::DataSet energy;
   SnapshotArrays per_file;  // what /bonds holds (PerFile arrays), empty until written
   hsize_t energy_rows = 0;
   std::size_t frames = 0;
   bool open = true;
+  bool failed = false;  // a write failed: the file cannot be finished (discard())
 };
 
 RunFile::RunFile(const std::filesystem::path& path, const std::string& scene_text) {
-  H5::Exception::dontPrint();  // errors reach the caller as exceptions instead
   std::filesystem::path partial = path;
   partial += ".partial";
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  guarded(partial, "create it", [&] { impl_ = std::make_unique<Impl>(path, partial, scene_text); });
+  bool failed = false;
+  try {
+    guarded(partial, "create it", failed, [&] { impl_ = std::make_unique<Impl>(path, partial, scene_text); });
+  } catch (const OutputError&) {
+    std::error_code ignored;
+    std::filesystem::remove(partial, ignored);  // nothing in it yet
+    throw;
+  }
 }
 
 RunFile::~RunFile() {
   if (!impl_ || !impl_->open) return;
+  if (failed()) {
+    discard();  // a file a write failed in is not a trajectory (the owner should have said so)
+    return;
+  }
   try {
-    impl_->file.close();  // the .partial stays: it holds every frame flushed so far
+    impl_->handle.close();  // the .partial stays: it holds every frame flushed so far
   } catch (const H5::Exception&) {
     // A destructor must not throw; the frames already flushed remain readable.
   }
+}
+
+bool RunFile::failed() const {
+  return impl_->failed || !impl_->handle.failure().empty();
+}
+
+void RunFile::discard() noexcept {
+  if (!impl_->open) return;
+  impl_->open = false;
+  impl_->handle.abandon();
+  std::error_code ignored;
+  std::filesystem::remove(impl_->partial, ignored);
 }
 
 void RunFile::writeFrame(const Snapshot& snapshot) {
@@ -173,19 +212,19 @@ void RunFile::writeFrame(const Snapshot& snapshot) {
   // The arrays are checked before anything is written.
   if (const auto bad = detail::bondProblem(snapshot, particleCount(snapshot)))
     throw std::invalid_argument("snapshot: " + bondProblemText(*bad));
-  guarded(impl_->partial, "write a frame", [&] {
-    const H5::Group frame = impl_->file.createGroup(frameGroupName(impl_->frames));
+  guardedWrite(*impl_, "write a frame", [&] {
+    const H5::Group frame = impl_->file().createGroup(frameGroupName(impl_->frames));
     writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
     writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
 #define ROCKLAB_WRITE(type, name, index, unit, frame_write, meaning)                          \
   if (FrameWrite::frame_write == FrameWrite::PerFile)                                         \
-    writeOncePerFile(impl_->file, frame, #name, snapshot.name, unit, impl_->per_file.name);   \
+    writeOncePerFile(impl_->file(), frame, #name, snapshot.name, unit, impl_->per_file.name); \
   else if (framed(FrameWrite::frame_write, snapshot.name.empty(), snapshot.clump_id.empty())) \
     writeArray(frame, #name, snapshot.name, unit);
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_WRITE)
 #undef ROCKLAB_WRITE
     // Flushing makes the frame (and the energy rows before it) survive a kill.
-    impl_->file.flush(H5F_SCOPE_GLOBAL);
+    impl_->handle.flush();
   });
   ++impl_->frames;
 }
@@ -203,7 +242,7 @@ void RunFile::appendEnergy(const Snapshot& snapshot) {
                                                static_cast<double>(snapshot.contacts)};
   // Not flushed here: rows may come every few steps; the next frame's flush
   // (or close) writes them out.
-  guarded(impl_->partial, "append an energy row", [&] {
+  guardedWrite(*impl_, "append an energy row", [&] {
     const hsize_t r = impl_->energy_rows;
     const std::array<hsize_t, 2> grown{r + 1, kEnergyColumns};
     impl_->energy.extend(grown.data());
@@ -223,19 +262,27 @@ std::size_t RunFile::frameCount() const {
 
 void RunFile::close(bool interrupted) {
   impl_->requireOpen("close");
-  guarded(impl_->partial, "finish it", [&] {
-    setIntAttribute(impl_->file, "complete", interrupted ? 0 : 1);
-    setIntAttribute(impl_->file, "interrupted", interrupted ? 1 : 0);
-    impl_->file.close();
-  });
+  if (impl_->failed) throw std::logic_error("RunFile::close after a failed write (discard() it)");
+  try {
+    guardedWrite(*impl_, "finish it", [&] {
+      setIntAttribute(impl_->file(), "complete", interrupted ? 0 : 1);
+      setIntAttribute(impl_->file(), "interrupted", interrupted ? 1 : 0);
+      impl_->handle.close();
+    });
+  } catch (const OutputError&) {
+    discard();  // the close failed (a full disk): the handle is abandoned, the .partial removed
+    throw;
+  }
   impl_->open = false;
   // rename() replaces an existing run file in one step: readers see the old
   // file or the new one, never a mixture.
   std::error_code error;
   std::filesystem::rename(impl_->partial, impl_->path, error);
   if (error) {
-    throw std::runtime_error("run file: cannot rename '" + impl_->partial.string() + "' to '" +
-                             impl_->path.string() + "': " + error.message());
+    std::error_code ignored;
+    std::filesystem::remove(impl_->partial, ignored);
+    throw OutputError("run file: cannot rename '" + impl_->partial.string() + "' to '" + impl_->path.string() +
+                      "': " + systemReason(error.value()));
   }
 }
 
@@ -264,7 +311,11 @@ RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::mak
     if (!impl_->file.nameExists("scene") || !impl_->file.nameExists("frames"))
       throw std::runtime_error(where + "not a rocklab run file (no /scene or /frames)");
     const H5::DataSet scene = impl_->file.openDataSet("scene");
+    if (scene.getTypeClass() != H5T_STRING || scene.getSpace().getSimpleExtentNpoints() != 1)
+      throw std::runtime_error(where + "dataset /scene is not a single string");
     scene.read(impl_->scene, scene.getStrType());
+    if (const auto c = detail::verifyChecksum(scene, impl_->scene.data(), impl_->scene.size()); !c.matches)
+      throw std::runtime_error(where + "dataset /scene: " + c.mismatch());
     const H5::Group frames = impl_->file.openGroup("frames");
     for (hsize_t k = 0; k < frames.getNumObjs(); ++k) impl_->frame_names.push_back(frames.getObjnameByIdx(k));
     std::sort(impl_->frame_names.begin(), impl_->frame_names.end());  // 000000, 000001, ...
@@ -297,8 +348,11 @@ const Snapshot& RunFileReader::frame(std::size_t k) {
     const H5::Group g = m.file.openGroup(group);
     Snapshot& s = m.snapshot;
     s = Snapshot{};
-    g.openAttribute("time").read(H5::PredType::NATIVE_DOUBLE, &s.time);
-    g.openAttribute("step").read(H5::PredType::NATIVE_UINT64, &s.step);
+    s.time = detail::readScalarAttribute<double>(g, "time", H5::PredType::NATIVE_DOUBLE);
+    s.step = detail::readScalarAttribute<std::uint64_t>(g, "step", H5::PredType::NATIVE_UINT64);
+    if (!std::isfinite(s.time) || s.time < 0)
+      throw std::runtime_error("attribute time of /" + group + ": " + std::to_string(s.time) +
+                               " s (allowed: >= 0 s, finite)");
     // A PerFile array comes from the frame when it carries its own, else from
     // /bonds, and only in a frame that holds bonds (bond_intact).
 #define ROCKLAB_READ(type, name, index, unit, frame, meaning) \
@@ -310,18 +364,22 @@ const Snapshot& RunFileReader::frame(std::size_t k) {
     c.name = m.per_file.name;
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_FROM_FILE)
 #undef ROCKLAB_FROM_FILE
-    if (c.material.empty()) c.material.assign(c.position.size(), 0);  // files from before materials were stored
 #define ROCKLAB_VIEW(type, name, index, unit, frame, meaning) s.name = c.name;
     ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_VIEW)
 #undef ROCKLAB_VIEW
-    const std::size_t n = detail::particleCount(s);
-    if (const auto bad = detail::bondProblem(s, n)) {
+    // Every size, index and number before anyone indexes with them (a renderer
+    // would read past an array).
+    if (const auto bad = detail::frameProblem(s)) {
       // Name the dataset the rows came from: the frame's own or the file's /bonds.
       const std::string per_file = std::string(kPerFileGroup) + "/" + bad->array;
       const bool from_file = !g.nameExists(bad->array) && m.file.nameExists(kPerFileGroup) &&
                              m.file.openGroup(kPerFileGroup).nameExists(bad->array);
       const std::string dataset = from_file ? per_file : group + "/" + bad->array;
       throw std::runtime_error("dataset /" + dataset + " row " + std::to_string(bad->row) + ": " + bad->what);
+    }
+    if (c.material.empty()) {  // files from before materials were stored
+      c.material.assign(c.position.size(), 0);
+      s.material = c.material;
     }
     return s;
   } catch (const H5::Exception& e) {

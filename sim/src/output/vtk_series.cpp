@@ -8,8 +8,10 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkTypeUInt64Array.h>
+#include <vtkErrorCode.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -21,6 +23,7 @@
 #include <system_error>
 #include <utility>
 
+#include "rocklab/sim/output/file_write.h"
 #include "rocklab/sim/particles.h"  // sim::Vec3
 #include "snapshot_check.h"
 
@@ -93,7 +96,11 @@ void writePolyData(vtkPolyData* poly, const std::filesystem::path& file) {
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToZLib();
   if (writer->Write() != 1) {
-    throw std::runtime_error("cannot write VTK file '" + file.string() + "'");
+    const unsigned long code = writer->GetErrorCode();
+    const std::string reason = code == vtkErrorCode::OutOfDiskSpaceError
+                                   ? systemReason(ENOSPC)
+                                   : "the VTK writer failed (vtkErrorCode " + std::to_string(code) + ")";
+    throw OutputError("cannot write VTK file '" + file.string() + "': " + reason);
   }
 }
 
@@ -111,13 +118,6 @@ void writeAtomically(const std::filesystem::path& target,
     std::filesystem::remove(temporary, ignored);
     throw;
   }
-}
-
-void writeText(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error("cannot write '" + file.string() + "'");
 }
 
 /// Shortest text that reads back as the same double (times like 0.1 stay "0.1").
@@ -184,8 +184,7 @@ void VtkSeries::writeCollection() const {
   }
   xml << "  </Collection>\n"
       << "</VTKFile>\n";
-  writeAtomically(directory_ / (basename_ + ".pvd"),
-                  [&](const std::filesystem::path& file) { writeText(file, xml.str()); });
+  writeFileAtomically(directory_ / (basename_ + ".pvd"), xml.str());
 }
 
 }  // namespace rocklab::sim::output

@@ -21,7 +21,7 @@ void World::Impl::rebuildNeighbours() {
   detail::PairList old = std::move(nb.pairs);
   std::vector<Vec3> old_shear = std::move(history.pair_shear);
   std::vector<double> old_relax = std::move(relax.pair);
-  const bool carry_relax = !old_relax.empty();
+  const bool carry_relax = relax.active();
   // Pairs held by intact contact bonds (§8.1) have no ordinary contact.
   const std::vector<std::uint64_t> bonded =
       bonds.contact_intact > 0 ? contactBondedPairs() : std::vector<std::uint64_t>{};

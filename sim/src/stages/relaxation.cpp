@@ -6,8 +6,7 @@ namespace rocklab::sim {
 /// of a world built with Model::relaxation.steps > 0).
 void World::Impl::startRelaxation() {
   relax.pending = false;
-  relax.pair.assign(nb.pairs.size(), 0.0);
-  relax.wall.assign(nb.wall_index.size(), 0.0);
+  relax.start(nb.pairs.size(), nb.wall_index.size());
   bool any = false;
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
@@ -27,20 +26,14 @@ void World::Impl::startRelaxation() {
       }
     }
   }
-  if (!any) {
-    relax.pair.clear();
-    relax.wall.clear();
-  }
+  if (!any) relax.stop();
 }
 
 /// Offset factor of this step; frees the offsets once the relaxation is over.
 void World::Impl::updateRelaxation() {
   const auto n = static_cast<std::uint64_t>(std::max(0, model.relaxation.steps));
   if (step >= n) {
-    relax.pair.clear();
-    relax.pair.shrink_to_fit();
-    relax.wall.clear();
-    relax.wall.shrink_to_fit();
+    relax.stop();
     guard.energy_ref_valid = false;  // the energy check starts afresh from the relaxed state
     return;
   }

@@ -15,6 +15,7 @@ namespace rocklab::sim {
 
 void World::Impl::watchdogStage(const StepPlan& plan, const StepChecks& checks) {
   checkOverlap(checks);
+  if (guard.check_travel) checkTravel();
   if (!plan.observe) return;
   // Checked whenever the energy is computed, not only every check_interval
   // steps: an observer may end the run (a drop test ends at the rebound)
@@ -64,6 +65,29 @@ void World::Impl::checkFinite() const {
       << fmtNum(time) << " s (step " << step << "): the run blew up. " << stepAdvice();
     throw WatchdogError(s.str());
   }
+}
+
+void World::Impl::checkTravel() {
+  // The last drift moved ball i by dt |v_i(t - dt/2)| (at step 0: the coming one).
+  std::size_t worst = p.size();
+  double worst_ratio = 1.0;  // travel / radius
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double ratio = p.velocity[i].norm() * dt / p.radius[i];
+    if (ratio > worst_ratio) {
+      worst_ratio = ratio;
+      worst = i;
+    }
+  }
+  if (worst == p.size()) return;
+  ++stats.far_travel_steps;
+  if (!stats.far_travel.empty()) return;
+  std::ostringstream s;
+  s << "at t = " << fmtNum(time) << " s (step " << step << ") particle " << p.id[worst] << " moved "
+    << fmtNum(worst_ratio * p.radius[worst]) << " m in one step, " << fmtNum(worst_ratio)
+    << " x its radius: it can pass through a wall or a ball without touching it. The step dt = " << fmtNum(dt)
+    << " s is forced above the automatic step " << fmtNum(audit.automatic)
+    << " s (timestep.allow_unsafe); results after this are not trustworthy";
+  stats.far_travel = s.str();
 }
 
 bool World::Impl::energyCheckApplies() const {

@@ -89,6 +89,11 @@ struct WorldStats {
   std::uint64_t network_checks = 0;  // step checks of the contact network done
   double network_step_ratio = 0.0;   // largest dt / (stable step of the network) they found; stops above 1
   std::array<double, kStageCount> stage_seconds{};  // s of wall time per Stage (index = Stage)
+  // Only with a dt forced above the automatic step (timestep.allow_unsafe): steps
+  // in which a ball moved farther than its radius (it can pass through a wall or a
+  // ball unseen), and the first of them described (ball, time, distance).
+  std::uint64_t far_travel_steps = 0;
+  std::string far_travel;
 };
 
 class World {

@@ -4,10 +4,11 @@
 // particle arrays including half-step velocities, contact history).
 //
 // Layout: attrs format = "rocklab-checkpoint", version = 1, time, step, dt,
-// half_kick_pending; /scene string; /particles/{position, velocity, omega [n,3],
+// half_kick_pending, run_crc32 (CRC-32 of those four); /scene string; /particles/{position, velocity, omega [n,3],
 // radius, inv_mass, inv_inertia, mass [n], material [n] int32, id [n] uint64};
 // /pairs/{i, j [m] uint32, shear [m,3]}; /walls/{particle, wall [k] uint32, shear [k,3]}.
-// Doubles are stored as IEEE doubles, so a read gives back the same bits.
+// Doubles are stored as IEEE doubles, so a read gives back the same bits. Every
+// dataset carries "unit" and "crc32" (CRC-32 of its bytes) attributes.
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -20,15 +21,24 @@ struct CheckpointError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Writes atomically (temporary file, then rename).
+/// Writes atomically (temporary file, then rename). A write that fails (a full
+/// disk) throws OutputError (file_write.h) naming the file and the system's
+/// reason, removes the temporary and leaves an existing checkpoint as it was; a
+/// state whose arrays disagree throws CheckpointError.
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
                      const std::string& scene_text);
 
 struct Checkpoint {
   WorldState state;
   std::string scene_text;
+  // Datasets (and the block of run attributes) read without a checksum: files
+  // written before checksums were stored are read, but unchecked.
+  std::size_t unchecked = 0;
 };
-/// Throws CheckpointError naming the file and what is wrong with it.
+/// Throws CheckpointError naming the file and what is wrong with it: a missing
+/// or misshapen dataset, array sizes that disagree, a checksum that does not
+/// match (random damage). The values themselves are checked by the World that
+/// restarts from them (World(Model, WorldState): dataset, row, what is allowed).
 Checkpoint readCheckpoint(const std::filesystem::path& path);
 
 }  // namespace rocklab::sim::output

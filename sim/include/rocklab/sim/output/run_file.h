@@ -1,7 +1,8 @@
 #pragma once
 // run.h5: the trajectory file of one run (HDF5).
 //
-// Layout (all values SI; every dataset carries a "unit" string attribute):
+// Layout (all values SI; every dataset carries a "unit" string attribute and,
+// but for the growing /energy table, "crc32", the CRC-32 of its bytes):
 //   /                      attrs: format = "rocklab-run", version = 1, complete (int 0/1),
 //                                 interrupted (int 0/1)
 //   /scene                 string dataset: the scene file text as run (after --set overrides)
@@ -35,15 +36,24 @@ namespace rocklab::sim::output {
 class RunFile {
  public:
   RunFile(const std::filesystem::path& path, const std::string& scene_text);
-  ~RunFile();  // closes without renaming if close() was not called (keeps the .partial)
+  /// closes without renaming if close() was not called (keeps the .partial of a
+  /// killed run readable); after a failed write, discards it.
+  ~RunFile();
   RunFile(const RunFile&) = delete;
   RunFile& operator=(const RunFile&) = delete;
 
+  /// A failure (a full disk) throws OutputError (file_write.h) naming the file and
+  /// the system's reason; the file is failed() from then on.
   void writeFrame(const Snapshot& snapshot);
   void appendEnergy(const Snapshot& snapshot);
   std::size_t frameCount() const;
-  /// Marks the file complete (or interrupted), closes it and renames it into place.
+  /// Marks the file complete (or interrupted), closes it and renames it into
+  /// place. Throws OutputError when that fails (the .partial is removed then).
   void close(bool interrupted);
+  /// A write failed: the file cannot be finished, only discard()ed.
+  bool failed() const;
+  /// Closes and removes the .partial (a failed run keeps no half-written trajectory).
+  void discard() noexcept;
 
  private:
   struct Impl;
