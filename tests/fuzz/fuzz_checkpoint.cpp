@@ -13,13 +13,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rocklab;
-  static const auto good = fuzz::templateRun() / "checkpoint.h5";
-  static const std::string good_bytes = fuzz::readFile(good);
-  static const std::vector<fuzz::ValueRegion> regions = fuzz::valueRegions(good);
-  std::string bytes = good_bytes;
-  fuzz::patchValues(bytes, regions, data, size);
-  const auto file = fuzz::scratchDir() / "checkpoint.h5";
-  fuzz::writeFile(file, bytes);
+  const auto file = fuzz::patchedTemplate("checkpoint.h5", data, size);
   std::unique_ptr<sim::World> world;
   try {
     sim::output::Checkpoint cp = sim::output::readCheckpoint(file);

@@ -12,13 +12,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rocklab;
-  static const auto good = fuzz::templateRun() / "run.h5";
-  static const std::string good_bytes = fuzz::readFile(good);
-  static const std::vector<fuzz::ValueRegion> regions = fuzz::valueRegions(good);
-  std::string bytes = good_bytes;
-  fuzz::patchValues(bytes, regions, data, size);
-  const auto file = fuzz::scratchDir() / "run.h5";
-  fuzz::writeFile(file, bytes);
+  const auto file = fuzz::patchedTemplate("run.h5", data, size);
   try {
     sim::output::RunFileReader run(file);
     const experiments::Scene scene = experiments::loadSceneText(run.sceneText(), file.string() + ":/scene", {}, {});

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -198,6 +199,21 @@ void patchValues(std::string& file, const std::vector<ValueRegion>& regions, con
       std::memcpy(where, &kIntegers[pick], r.element);  // little-endian: the low bytes
     }
   }
+}
+
+std::filesystem::path patchedTemplate(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  struct Template {
+    std::string bytes;
+    std::vector<ValueRegion> regions;
+  };
+  static std::map<std::string, Template> templates;
+  auto [it, made] = templates.try_emplace(name);
+  if (made) it->second = {readFile(templateRun() / name), valueRegions(templateRun() / name)};
+  std::string bytes = it->second.bytes;
+  patchValues(bytes, it->second.regions, data, size);
+  const auto file = scratchDir() / name;
+  writeFile(file, bytes);
+  return file;
 }
 
 }  // namespace rocklab::fuzz

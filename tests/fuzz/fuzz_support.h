@@ -43,4 +43,8 @@ std::vector<ValueRegion> valueRegions(const std::filesystem::path& file);
 void patchValues(std::string& file, const std::vector<ValueRegion>& regions, const std::uint8_t* data,
                  std::size_t size);
 
+/// The template file `name` of templateRun() with the input's patches applied,
+/// written to the scratch folder under the same name; returns its path.
+std::filesystem::path patchedTemplate(const std::string& name, const std::uint8_t* data, std::size_t size);
+
 }  // namespace rocklab::fuzz
