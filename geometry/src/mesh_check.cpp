@@ -90,9 +90,8 @@ TriangleMesh weldIdenticalVertices(const TriangleMesh& mesh) {
 }
 
 TriangleMesh readMeshFile(const std::string& path, double scale) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw MeshCheckError("mesh file '" + path + "' does not exist");
+  if (const std::string problem = detail::notAFile(path); !problem.empty())
+    throw MeshCheckError("mesh file '" + path + "' " + problem);
   if (!std::ifstream(path).good()) throw MeshCheckError("mesh file '" + path + "' cannot be opened for reading");
   Assimp::Importer importer;
   // No JoinIdenticalVertices here: welding is done below across all meshes of the file.

@@ -9,6 +9,8 @@
 namespace rocklab::geometry {
 
 TriangleMesh importMesh(const std::string& path, double scale) {
+  if (const std::string problem = detail::notAFile(path); !problem.empty())
+    throw MeshImportError("cannot read mesh '" + path + "': " + problem);
   Assimp::Importer importer;
   // Per-face normals keep STL vertices apart; drop normals so that welding works.
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);

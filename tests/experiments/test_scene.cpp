@@ -189,6 +189,8 @@ TEST_CASE("messages name the --set or file - line of the key they blame - with s
   CHECK_THAT(errorOf(kMinimal, {"scene.=1"}), Contains("--set scene.=1: the key has an empty part"));
   CHECK_THAT(errorOf(kMinimal, {".scene=1"}), Contains("empty part"));
   CHECK_THAT(errorOf(kMinimal, {"scene=1"}), Contains("--set scene=1: 'scene' is a table"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0=1"}), Contains("'particles' is an array of tables"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.radius.x=1"}), Contains("'particles.0.radius' is a number, not a table"));
   // Numbers as written, not 17 digits (toml++ prints -0.0040000000000000001).
   const std::string negative = errorOf(kMinimal, {"scene.end_time=-0.004"});
   CHECK_THAT(negative, Contains("--set scene.end_time=-0.004: key 'scene.end_time' = -0.004: out of range"));
@@ -209,6 +211,8 @@ TEST_CASE("messages name the --set or file - line of the key they blame - with s
   // A folder is not a scene; `extends` says its line.
   const auto dir = std::filesystem::temp_directory_path();
   CHECK_THROWS_WITH(loadScene(dir), Contains("is a directory"));
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"" + dir.string() + "\"\n"),
+             Contains("key 'walls.0.file'") && Contains("is a directory"));
   CHECK_THAT(errorOf("extends = \".\"\n"), Contains("bad.toml:1: key 'extends'") && Contains("is a directory"));
 }
 

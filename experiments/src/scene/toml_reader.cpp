@@ -466,7 +466,13 @@ std::string applyOverride(toml::table& root, const std::string& assignment) {
     }
   }
   auto t = cur->as_table();
-  if (!t) throw SceneError("--set " + assignment + ": the parent of the last key is not a table");
+  if (!t) {
+    const std::string parent = key.substr(0, key.rfind('.'));
+    if (cur->is_array_of_tables())
+      throw SceneError("--set " + assignment + ": '" + parent + "' is an array of tables; set a key of one entry, e.g. --set " +
+                       parent + ".0.KEY=VALUE");
+    throw SceneError("--set " + assignment + ": '" + parent + "' is " + typeName(*cur) + ", not a table");
+  }
   // A table is changed key by key: a number or string in its place would drop
   // all of it ([[walls]] may be replaced by another array, e.g. []).
   const toml::node& new_value = *parsed.get("v");
