@@ -29,6 +29,9 @@ fi
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/scripts/sanitizer-suppressions.txt:print_suppressions=0}
+# The targets' scratch folders (one per process) go below the build, not /tmp.
+export TMPDIR="$bin_dir/tmp"
+mkdir -p "$TMPDIR"
 declare -A max_len=([scene]=16384 [mesh]=16384 [checkpoint]=600 [run_file]=600 [collect]=8192)
 status=0
 for t in "${targets[@]}"; do

@@ -4,8 +4,11 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <algorithm>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -177,11 +180,19 @@ void patchValues(std::string& file, const std::vector<ValueRegion>& regions, con
                                    std::numeric_limits<double>::infinity(), 1e300, 1e-300, -0.0};
   static const std::int64_t kIntegers[] = {0, -1, -5, 2147483648LL, 2000000000, 99, 1, 4294967295LL,
                                            std::numeric_limits<std::int64_t>::max(), 65536};
+  // ROCKLAB_FUZZ_VERBOSE=1: each patch on stderr, to say what a finding changed.
+  static const bool verbose = std::getenv("ROCKLAB_FUZZ_VERBOSE") != nullptr;
   for (std::size_t k = 0; k + 6 <= size; k += 6) {
     const ValueRegion& r = regions[data[k] % regions.size()];
     const std::uint8_t op = data[k + 1];
     std::uint32_t at = 0;
     std::memcpy(&at, data + k + 2, 4);
+    if (verbose)
+      std::fprintf(stderr, "patch %s (%zu bytes of %zu-byte %s): %s at %zu\n", r.name.c_str(), r.size, r.element,
+                   r.floating ? "floats" : "integers",
+                   op % 2 ? ("edge value " + std::to_string((op / 2) % 10)).c_str()
+                          : ("byte " + std::to_string(op / 2)).c_str(),
+                   static_cast<std::size_t>(op % 2 ? at % std::max<std::size_t>(1, r.size / r.element) : at % r.size));
     if (op % 2 == 0) {
       file[r.offset + at % r.size] = static_cast<char>(op / 2);
       continue;
