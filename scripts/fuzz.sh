@@ -30,7 +30,8 @@ fi
 
 # UBSan findings stop the run like ASan's; leaks inside libOSMesa are not ours.
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+# Full stacks for leaks, so that the suppressions can match library frames.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:fast_unwind_on_malloc=0}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/scripts/sanitizer-suppressions.txt:print_suppressions=0}
 # The targets' scratch folders (one per process) go below the build, not /tmp.
 export TMPDIR="$bin_dir/tmp"
@@ -58,8 +59,8 @@ for t in "${targets[@]}"; do
     result="FINDING: $(grep -m1 -E 'ERROR: |runtime error|deadly signal|Timeout|out-of-memory|terminate' "$log" || echo "see $log")"
     status=1
   fi
-  runs=$(grep -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$log" | tail -1)
-  ((${#keep_going[@]} == 0)) || runs=$(grep -oP '#\K[0-9]+(?=: cov)' "$log" | tail -1)
+  runs=$(grep -oP 'stat::number_of_executed_units:\s*\K[0-9]+' "$log" | tail -1 || true)
+  ((${#keep_going[@]} == 0)) || runs=$(grep -oP '#\K[0-9]+(?=: cov)' "$log" | tail -1 || true)
   echo "fuzz $t: ${seconds} s, $runs executions, $result (log: $log)"
 done
 exit $status
