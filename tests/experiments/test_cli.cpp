@@ -117,7 +117,7 @@ TEST_CASE("command-line messages: short ranges - the value that is not a number 
   }
 }
 
-TEST_CASE("--quiet prints nothing for a good run and the error for a bad one", "[cli]") {
+TEST_CASE("a quiet run (option quiet) prints nothing when good and its error when bad", "[cli]") {
   const fs::path out = tempDir("quiet");
   const auto [code, log] = cliStderr({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=0.001",
                                       "--set", "particles.0.count=20", "--set", "output.hdf5=false"});
