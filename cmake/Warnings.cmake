@@ -19,3 +19,12 @@ if(ROCKLAB_SANITIZE)
   target_compile_options(rocklab_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
   target_link_options(rocklab_warnings INTERFACE -fsanitize=address,undefined)
 endif()
+if(ROCKLAB_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "ROCKLAB_FUZZ=ON needs clang (cmake --preset asan-clang)")
+  endif()
+  # Coverage feedback for libFuzzer in every rocklab library; the fuzz targets add
+  # -fsanitize=fuzzer (the libFuzzer main) themselves.
+  target_compile_options(rocklab_warnings INTERFACE -fsanitize=fuzzer-no-link)
+  target_link_options(rocklab_warnings INTERFACE -fsanitize=fuzzer-no-link)
+endif()

@@ -3,12 +3,23 @@
 // scaled; faces that are not triangles — points, lines — skipped). Shared by
 // importMesh (mesh walls) and readMeshFile (particle scans). Internal.
 #include <cstdint>
+#include <filesystem>
+#include <string>
 
 #include <assimp/scene.h>
 
 #include "rocklab/geometry/triangle_mesh.h"
 
 namespace rocklab::geometry::detail {
+
+/// "" or why `path` cannot be a mesh file before assimp sees it (assimp says
+/// only "No suitable reader found" for a folder).
+inline std::string notAFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return "does not exist";
+  if (std::filesystem::is_directory(path, ec)) return "is a directory, not a mesh file";
+  return {};
+}
 
 inline TriangleMesh trianglesOf(const aiScene& scene, double scale) {
   TriangleMesh mesh;

@@ -44,6 +44,28 @@ std::vector<EdgeUse> edgeUses(const std::vector<Tri>& tris) {
   return uses;
 }
 
+/// Edges a message names (where to look in the scan), at most.
+constexpr std::size_t kEdgesNamed = 3;
+
+/// ", e.g. at (x, y, z)-(x, y, z), ..." for the edges `keys` (lo << 32 | hi) of `count`.
+std::string edgeList(const std::vector<Vec3>& v, const std::vector<std::uint64_t>& keys, std::size_t count) {
+  std::ostringstream s;
+  s.precision(4);
+  const auto point = [&s, &v](std::uint64_t index) {
+    const Vec3& p = v[static_cast<std::size_t>(index)];
+    s << '(' << p.x() << ", " << p.y() << ", " << p.z() << ')';
+  };
+  s << (count > keys.size() ? ", e.g. at " : " at ");
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    s << (k ? ", " : "");
+    point(keys[k] >> 32);
+    s << '-';
+    point(keys[k] & 0xffffffffu);
+  }
+  s << " m";
+  return s.str();
+}
+
 double signedVolume(const std::vector<Vec3>& v, const std::vector<Tri>& tris, const std::vector<std::uint32_t>& which) {
   // Divergence theorem: sum of signed tetrahedra (origin, a, b, c).
   double six_v = 0;
@@ -69,9 +91,8 @@ TriangleMesh weldIdenticalVertices(const TriangleMesh& mesh) {
 }
 
 TriangleMesh readMeshFile(const std::string& path, double scale) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw MeshCheckError("mesh file '" + path + "' does not exist");
+  if (const std::string problem = detail::notAFile(path); !problem.empty())
+    throw MeshCheckError("mesh file '" + path + "' " + problem);
   if (!std::ifstream(path).good()) throw MeshCheckError("mesh file '" + path + "' cannot be opened for reading");
   // assimp aborts on some malformed files: only a file whose structure agrees with
   // its own counts is handed to it.
@@ -85,6 +106,9 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
                          importer.GetErrorString());
   TriangleMesh soup = detail::trianglesOf(*scene, scale);
   if (soup.triangles.empty()) throw MeshCheckError("mesh file '" + path + "' contains no triangles");
+  // Before welding: NaN breaks the ordering the weld relies on.
+  if (const std::string bad = soup.nonFiniteVertex(); !bad.empty())
+    throw MeshCheckError("mesh file '" + path + "': " + bad);
   return weldIdenticalVertices(soup);
 }
 
@@ -94,6 +118,7 @@ TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& nam
   report.input_triangles = mesh.triangles.size();
   report.vertices = mesh.vertices.size();
   if (mesh.triangles.empty()) throw MeshCheckError(where + "contains no triangles");
+  if (const std::string bad = mesh.nonFiniteVertex(); !bad.empty()) throw MeshCheckError(where + bad);
   for (const Tri& t : mesh.triangles)
     for (std::uint32_t i : t)
       if (i >= mesh.vertices.size()) throw MeshCheckError(where + "a triangle refers to a vertex that does not exist");
@@ -121,12 +146,13 @@ TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& nam
   // 2. Edge topology: closed = every edge used exactly twice.
   const std::vector<EdgeUse> uses = edgeUses(tris);
   std::vector<std::vector<std::pair<std::uint32_t, bool>>> neighbours(tris.size());  // (triangle, same direction)
+  std::vector<std::uint64_t> open_edges, nonmanifold_edges;  // the first few, to say where
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
     const std::size_t n = j - i;
-    if (n == 1) ++report.boundary_edges;
-    if (n > 2) ++report.nonmanifold_edges;
+    if (n == 1 && ++report.boundary_edges <= kEdgesNamed) open_edges.push_back(uses[i].key);
+    if (n > 2 && ++report.nonmanifold_edges <= kEdgesNamed) nonmanifold_edges.push_back(uses[i].key);
     if (n == 2) {
       const EdgeUse &x = uses[i], &y = uses[i + 1];
       const bool same = x.forward == y.forward;  // same direction = orientations disagree
@@ -140,10 +166,12 @@ TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& nam
     msg << where;
     if (report.boundary_edges)
       msg << "not closed: " << report.boundary_edges
-          << " open boundary edges (edges of only one triangle: holes or cracks)";
+          << " open boundary edges (edges of only one triangle: holes or cracks)"
+          << edgeList(mesh.vertices, open_edges, report.boundary_edges);
     if (report.boundary_edges && report.nonmanifold_edges) msg << "; ";
     if (report.nonmanifold_edges)
-      msg << report.nonmanifold_edges << " non-manifold edges (shared by more than two triangles)";
+      msg << report.nonmanifold_edges << " non-manifold edges (shared by more than two triangles)"
+          << edgeList(mesh.vertices, nonmanifold_edges, report.nonmanifold_edges);
     msg << ". A clump needs one closed, manifold surface: repair the scan (e.g. close holes, "
            "remove duplicate faces) and try again";
     throw MeshCheckError(msg.str());

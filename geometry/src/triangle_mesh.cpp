@@ -27,9 +27,21 @@ Vec3 TriangleMesh::closestPoint(const Vec3& p) const {
   return best;
 }
 
+std::string TriangleMesh::nonFiniteVertex() const {
+  for (std::size_t k = 0; k < vertices.size(); ++k)
+    if (!vertices[k].allFinite()) {
+      std::ostringstream msg;
+      msg << "vertex " << k << " has " << (vertices[k].hasNaN() ? "a NaN" : "an infinite") << " coordinate ("
+          << vertices[k].x() << ", " << vertices[k].y() << ", " << vertices[k].z() << ")";
+      return msg.str();
+    }
+  return {};
+}
+
 std::string TriangleMesh::validate() const {
   std::ostringstream msg;
   if (triangles.empty()) return "the mesh has no triangles";
+  if (std::string bad = nonFiniteVertex(); !bad.empty()) return bad;
   for (std::size_t k = 0; k < triangles.size(); ++k) {
     for (std::uint32_t idx : triangles[k]) {
       if (idx >= vertices.size()) {

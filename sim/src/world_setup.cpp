@@ -39,15 +39,8 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
       if (!w.motion.angular_velocity.isZero(0))
         return where + ": an infinite plane cannot rotate; use a polygon";
     }
-    if (w.shape == WallShape::Polygon) {
-      if (w.vertices.size() < 3) return where + ": a polygon needs at least 3 vertices";
-      const Vec3 nrm = polygonNormal(w.vertices);
-      if (!(nrm.norm() > 0)) return where + ": the first three vertices are collinear";
-      const double scale = (w.vertices[1] - w.vertices[0]).norm();
-      for (const Vec3& v : w.vertices)
-        if (std::abs((v - w.vertices[0]).dot(nrm)) > 1e-9 * std::max(1.0, scale))
-          return where + ": the vertices are not in one plane";
-    }
+    if (w.shape == WallShape::Polygon)
+      if (const std::string problem = polygonProblem(w.vertices); !problem.empty()) return where + ": " + problem;
     if (w.shape == WallShape::Mesh) {
       const std::string msg = w.mesh.validate();
       if (!msg.empty()) return where + ": " + msg;

@@ -31,6 +31,14 @@ std::string slurp(const fs::path& p) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 const std::string kScene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/hopper.toml";
+/// The exit code and what the command printed on stderr.
+std::pair<int, std::string> cliStderr(const std::vector<std::string>& args) {
+  std::ostringstream log;
+  auto* const old = std::cerr.rdbuf(log.rdbuf());
+  const int code = cli(args);
+  std::cerr.rdbuf(old);
+  return {code, log.str()};
+}
 }  // namespace
 
 TEST_CASE("help and usage errors", "[cli]") {
@@ -85,6 +93,39 @@ TEST_CASE("bad input: exit code 2 and the previous outputs are untouched", "[cli
   CHECK(cli({"restart", "/no/such/checkpoint.h5", "--out", out.string()}) == 2);
   CHECK(slurp(out / "results.json") == "{\"previous\": true}\n");
   CHECK(!fs::exists(out / "run.h5"));
+  fs::remove_all(out);
+}
+
+TEST_CASE("command-line messages: short ranges - the value that is not a number - a folder is no scene", "[cli]") {
+  const auto [threads_code, threads] = cliStderr({"run", kScene, "--threads", "-1"});
+  CHECK(threads_code == 2);
+  CHECK_THAT(threads, Catch::Contains("--threads") && Catch::Contains("not in range 0 to 4096"));
+  CHECK(threads.size() < 200);  // not the largest double in 309 digits
+  const auto [target_code, target] =
+      cliStderr({"calibrate", "drop", "--vary", "contact.damping_normal=0:0.4", "--target", "restitution=abc"});
+  CHECK(target_code == 2);
+  CHECK_THAT(target, Catch::Contains("--target restitution=abc: 'abc' is not a number"));
+  // A folder where a file belongs: said so by every command that reads one.
+  const std::string folder = fs::temp_directory_path().string();
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"check", folder}, {"restart", folder, "--out", tempDir("dir").string()},
+        {"render", folder, "--out", tempDir("dir").string()},
+        {"shape", folder, "--out", tempDir("dir").string(), "--no-preview"}}) {
+    const auto [dir_code, dir] = cliStderr(args);
+    CHECK(dir_code == 2);
+    CHECK_THAT(dir, Catch::Contains("is a directory"));
+  }
+}
+
+TEST_CASE("a quiet run (option quiet) prints nothing when good and its error when bad", "[cli]") {
+  const fs::path out = tempDir("quiet");
+  const auto [code, log] = cliStderr({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=0.001",
+                                      "--set", "particles.0.count=20", "--set", "output.hdf5=false"});
+  CHECK(code == 0);
+  CHECK(log.empty());  // not the time-step audit, not the summary
+  const auto [bad_code, bad] = cliStderr({"run", kScene, "--out", out.string(), "--quiet", "--set", "foo.bar=1"});
+  CHECK(bad_code == 2);
+  CHECK_THAT(bad, Catch::Contains("error: --set foo.bar=1: unknown key 'foo'"));
   fs::remove_all(out);
 }
 
@@ -161,13 +202,11 @@ TEST_CASE("restart refuses an experiment scene and writes nothing", "[cli]") {
   REQUIRE(cli({"run", "drop", "--out", out.string(), "--quiet", "--set", "scene.end_time=0.01", "--set",
                "output.checkpoint=true"}) == 0);
   REQUIRE(fs::exists(out / "checkpoint.h5"));
-  std::ostringstream log;
-  auto* const old = std::cerr.rdbuf(log.rdbuf());
-  const int code = cli({"restart", (out / "checkpoint.h5").string(), "--out", out2.string(), "--quiet", "--set",
-                        "scene.end_time=0.02"});
-  std::cerr.rdbuf(old);
+  const auto [code, log] = cliStderr({"restart", (out / "checkpoint.h5").string(), "--out", out2.string(),
+                                      "--quiet", "--set", "scene.end_time=0.02"});
   CHECK(code == 2);
-  CHECK_THAT(log.str(), Catch::Contains("experiment.drop scenes cannot be restarted from a checkpoint"));
+  CHECK_THAT(log, Catch::Contains("experiment.drop scenes cannot be restarted from a checkpoint"));
+  CHECK_THAT(log, Catch::Contains("error: " + (out / "checkpoint.h5").string() + ": "));  // names the file
   CHECK_FALSE(fs::exists(out2));
   fs::remove_all(out);
 }

@@ -177,7 +177,43 @@ TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
   CHECK(spheres.clumps.empty());
   CHECK(spheres.spheres.size() == 1680);
   CHECK_THROWS_WITH(loadSceneText("extends = \"nowhere.toml\"\n", "x.toml", {}, dir),
-                    Contains("x.toml: extends = \"nowhere.toml\": cannot open"));
+                    Contains("x.toml:1: key 'extends' = \"nowhere.toml\": cannot open"));
+}
+
+TEST_CASE("messages name the --set or file - line of the key they blame - with short numbers", "[scene]") {
+  // A table only a --set made: the override, not "<scene>".
+  const std::string made = errorOf(kMinimal, {"foo.bar=1"});
+  CHECK_THAT(made, Contains("--set foo.bar=1: unknown key 'foo'"));
+  CHECK_THAT(made, !Contains("<scene>"));
+  // An empty key part would replace a table: refused, as is a value for a table.
+  CHECK_THAT(errorOf(kMinimal, {"scene.=1"}), Contains("--set scene.=1: the key has an empty part"));
+  CHECK_THAT(errorOf(kMinimal, {".scene=1"}), Contains("empty part"));
+  CHECK_THAT(errorOf(kMinimal, {"scene=1"}), Contains("--set scene=1: 'scene' is a table"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0=1"}), Contains("'particles' is an array of tables"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.radius.x=1"}), Contains("'particles.0.radius' is a number, not a table"));
+  // Numbers as written, not 17 digits (toml++ prints -0.0040000000000000001).
+  const std::string negative = errorOf(kMinimal, {"scene.end_time=-0.004"});
+  CHECK_THAT(negative, Contains("--set scene.end_time=-0.004: key 'scene.end_time' = -0.004: out of range"));
+  CHECK_THAT(errorOf(kMinimal + "\n[gravity]\nvector = [0.1, 0.2]\n"), Contains("= [0.1, 0.2]"));
+  // What the World would refuse without a key: the reader says key and line.
+  std::string stiffless = kMinimal;
+  stiffless.replace(stiffless.find("kn = 1e7"), 8, "kn = 0");
+  CHECK_THAT(errorOf(stiffless), Contains("bad.toml:8: key 'materials.rock.kn' = 0: the linear contact law"));
+  CHECK_THAT(errorOf(kMinimal, {"materials.rock.kn=0"}), Contains("--set materials.rock.kn=0: key 'materials.rock.kn'"));
+  CHECK_THAT(errorOf(kMinimal, {"contact.law=\"hertz_mindlin\""}),
+             Contains("bad.toml:6: key 'materials.rock.shear_modulus'"));
+  const std::string polygon = "\n[[walls]]\ntype = \"polygon\"\nmaterial = \"rock\"\n"
+                              "vertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]\n";
+  CHECK_THAT(errorOf(kMinimal + polygon), Contains("bad.toml:19: key 'walls.0.vertices'") && Contains("collinear"));
+  const std::string skew = "\n[[walls]]\ntype = \"polygon\"\nmaterial = \"rock\"\n"
+                           "vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.5]]\n";
+  CHECK_THAT(errorOf(kMinimal + skew), Contains("vertex 3 is not in the plane"));
+  // A folder is not a scene; `extends` says its line.
+  const auto dir = std::filesystem::temp_directory_path();
+  CHECK_THROWS_WITH(loadScene(dir), Contains("is a directory"));
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"" + dir.string() + "\"\n"),
+             Contains("key 'walls.0.file'") && Contains("is a directory"));
+  CHECK_THAT(errorOf("extends = \".\"\n"), Contains("bad.toml:1: key 'extends'") && Contains("is a directory"));
 }
 
 TEST_CASE("set overrides address an array entry by its name", "[scene]") {
@@ -250,14 +286,18 @@ TEST_CASE("camera keys are checked and a scene without cameras has none", "[scen
   CHECK(s.wall_looks.size() == s.model.walls.size());
   CHECK(s.wall_looks[1].opacity == Approx(0.15));  // the camera-side Perspex
   CHECK(loadScene(std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/drop.toml").cameras.empty());
+  // A named camera is named in messages as --set addresses it.
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.resolution=[960]"}),
-                    Contains("cameras.0.resolution"));
-  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.fov_deg=200"}), Contains("cameras.0.fov_deg"));
+                    Contains("cameras.side.resolution"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.fov_deg=200"}), Contains("cameras.side.fov_deg"));
+  // The eye on the target is the eye's fault, not up's.
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.eye=[0.27, 0.15, 0.05]"}),
-                    Contains("cameras.0.up"));
+                    Contains("key 'cameras.side.eye'") && Contains("equals target"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.up=[0, 1, 0]"}), Contains("key 'cameras.side.up'"));
   CHECK_THROWS_WITH(loadScene(file, {"cameras.side.motion_blur=true"}),
                     Contains("needs exposure > 0 s"));
-  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.lens=1"}), Contains("cameras.0.lens"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.lens=1"}), Contains("cameras.side.lens"));
+  CHECK_THROWS_WITH(loadScene(file, {"cameras.side.k1=-3"}), Contains("key 'cameras.side.k1'"));
 }
 
 TEST_CASE(

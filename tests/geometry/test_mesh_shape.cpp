@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 
 #include "rocklab/geometry/mesh_check.h"
@@ -194,6 +195,7 @@ TEST_CASE("every bad mesh class gives its message", "[mesh]") {
     const std::string msg = checkFile(dir / "open.obj", r);
     CHECK_THAT(msg, Catch::Contains("not closed: 3 open boundary edges"));
     CHECK_THAT(msg, Catch::Contains("open.obj"));
+    CHECK_THAT(msg, Catch::Contains("holes or cracks) at ("));  // where the hole is
   }
   SECTION("non-manifold edges") {
     TriangleMesh fin = cube;  // two cubes sharing one edge: that edge has four triangles
@@ -207,7 +209,23 @@ TEST_CASE("every bad mesh class gives its message", "[mesh]") {
       fin.triangles.push_back(u);
     }
     writeMeshFile((dir / "fin.stl").string(), fin);  // welded on reading
-    CHECK_THAT(checkFile(dir / "fin.stl", r), Catch::Contains("1 non-manifold edges"));
+    const std::string msg = checkFile(dir / "fin.stl", r);
+    CHECK_THAT(msg, Catch::Contains("1 non-manifold edges"));
+    // Where: the shared edge's two ends, short numbers.
+    CHECK_THAT(msg, Catch::Contains("(0.01, 0.01, 0)") && Catch::Contains("(0.01, 0.01, 0.01)"));
+  }
+  SECTION("NaN coordinates are called NaN, not a flat surface") {
+    TriangleMesh m = cube;
+    m.vertices[5].y() = std::nan("");
+    try {
+      checkAndRepairMesh(m, "nan", r);
+      FAIL("a NaN vertex was accepted");
+    } catch (const MeshCheckError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("vertex 5 has a NaN coordinate"));
+    }
+    CHECK_THAT(m.validate(), Catch::Contains("vertex 5 has a NaN coordinate"));  // mesh walls
+    m.vertices[5].y() = std::numeric_limits<double>::infinity();
+    CHECK_THAT(m.validate(), Catch::Contains("vertex 5 has an infinite coordinate"));
   }
   SECTION("inconsistent orientation is fixed and reported") {
     TriangleMesh m = cube;

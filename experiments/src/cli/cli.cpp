@@ -17,6 +17,7 @@
 #include "analysis/weibull_report.h"
 #include "camera/render_run.h"
 #include "common/json_text.h"
+#include "common/quiet_log.h"
 #include "rocklab/experiments/bond_calibration.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
@@ -169,19 +170,39 @@ struct CliArgs {
   int count = 30, trials = 3, trial_orientations = 1;
 };
 
+/// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
+/// print its upper bound, the largest double, in 309 digits.
+const CLI::Range kCountRange(0, 4096);
+
+/// `text` (the value of option `what`) as a number; std::invalid_argument names
+/// both (std::stod alone says only "stod").
+double numberArgument(const std::string& what, const std::string& text) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size())
+    throw std::invalid_argument(what + ": '" + text + "' is not a number");
+  return value;
+}
+
 void addRunOptions(CLI::App* c, CliArgs& a) {
   c->add_option("--out", a.out_dir, "Output directory (default: out/<scene name>)");
   c->add_option("--set", a.overrides, "Override a scene key, e.g. --set timestep.dt=1e-6 (TOML value)")
       ->take_all();
-  c->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
-  c->add_flag("--quiet", a.quiet, "No progress line");
+  c->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")->check(kCountRange);
+  c->add_flag("--quiet", a.quiet,
+              "Print only errors and warnings (no set-up lines, time-step audit, progress or summary)");
 }
 
 void addSetOptions(CLI::App* c, CliArgs& a) {
   c->add_option("--jobs", a.jobs,
                 "Runs at once, each its own process of one thread (default: one per core); 0 = one after the "
                 "other in this process, each with --threads")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kCountRange);
   c->add_option("--plan", a.plan_dir,
                 "Write the run list (runs.txt), a Slurm array script and a README into DIR and run nothing; "
                 "`rocklab collect DIR` merges the runs afterwards");
@@ -329,16 +350,8 @@ int studyCommand(const CliArgs& a) {
     for (const std::string& v : a.vary) so.runs.vary.push_back(parseVary(v));
     if (!a.figure.empty()) so.figure = a.figure;
     if (a.reference == "finest") so.reference.reset();
-    else if (!a.reference.empty()) {
-      std::size_t used = 0;
-      try {
-        so.reference = std::stod(a.reference, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != a.reference.size())
-        throw std::invalid_argument("--reference '" + a.reference + "': give finest or a number (a lab value)");
-    }
+    else if (!a.reference.empty())
+      so.reference = numberArgument("--reference (finest or a lab value)", a.reference);
     if (a.tolerance > 0) so.tolerance_pct = a.tolerance;
     if (a.seeds > 0) so.seeds = a.seeds;
     applySetOptions(a, so.runs);
@@ -370,9 +383,7 @@ int sweepCommand(const CliArgs& a, bool calibrate) {
     const auto eq = a.target.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("--target '" + a.target + "': expected metric=value");
     co.target_metric = a.target.substr(0, eq);
-    std::size_t used = 0;
-    co.target = std::stod(a.target.substr(eq + 1), &used);
-    if (used != a.target.size() - eq - 1) throw std::invalid_argument("--target '" + a.target + "': value is not a number");
+    co.target = numberArgument("--target " + a.target, a.target.substr(eq + 1));
     return runCalibrate(co, std::cerr);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -424,6 +435,7 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
       const sim::output::Checkpoint cp = sim::output::readCheckpoint(a.checkpoint_arg);
       scene = loadSceneText(cp.scene_text, a.checkpoint_arg + ":/scene", a.overrides,
                             std::filesystem::path(a.checkpoint_arg).parent_path());
+      scene.source = a.checkpoint_arg;  // what the run's messages name
       options.restart = a.checkpoint_arg;
     } else {
       const std::string name = command == "demo" ? "demo" : a.scene_arg;
@@ -458,7 +470,9 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
     }
   }
   const StopOnSignals stop_on_signals;
-  return runScene(scene, options, std::cerr);
+  detail::QuietLogBuffer quiet(std::cerr);
+  std::ostream quiet_log(&quiet);
+  return runScene(scene, options, a.quiet ? quiet_log : std::cerr);
 }
 
 /// The command line parsed and run; `name` is set to the subcommand's name once known.

@@ -63,22 +63,23 @@ void mergeInto(toml::table& base, const toml::table& over) {
 /// A scene may start with `extends = "other.toml"` (path relative to the
 /// scene): it then holds only what differs from that scene, e.g. another
 /// inclination.
-void resolveExtends(toml::table& table, const std::string& source_name,
-                    const std::filesystem::path& base_dir, int depth) {
+void resolveExtends(toml::table& table, const std::filesystem::path& base_dir, int depth) {
   const toml::node* e = table.get("extends");
   if (!e) return;
   const auto name = e->value<std::string>();
-  if (!name)
-    throw SceneError(source_name + ": extends: expected the file name of the scene to extend");
-  if (depth > 8) throw SceneError(source_name + ": extends: more than 8 levels (a cycle?)");
+  const std::string at = detail::where(e->source()) + "key 'extends'";
+  if (!name) throw SceneError(at + ": expected the file name of the scene to extend");
+  if (depth > 8) throw SceneError(at + " = \"" + *name + "\": more than 8 levels (a cycle?)");
   const std::filesystem::path file = base_dir / *name;
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw SceneError(at + " = \"" + *name + "\": " + file.string() + " is a directory, not a scene file");
   std::ifstream in(file);
-  if (!in)
-    throw SceneError(source_name + ": extends = \"" + *name + "\": cannot open " + file.string());
+  if (!in) throw SceneError(at + " = \"" + *name + "\": cannot open " + file.string());
   std::stringstream buf;
   buf << in.rdbuf();
   toml::table base = parseToml(buf.str(), file.string());
-  resolveExtends(base, file.string(), file.parent_path(), depth + 1);
+  resolveExtends(base, file.parent_path(), depth + 1);
   table.erase("extends");
   mergeInto(base, table);
   table = std::move(base);
@@ -90,12 +91,9 @@ Scene loadSceneText(const std::string& text, const std::string& source_name,
                     const std::vector<std::string>& overrides,
                     const std::filesystem::path& base_dir) {
   toml::table table = parseToml(text, source_name);
-  resolveExtends(table, source_name, base_dir, 0);
+  resolveExtends(table, base_dir, 0);
   auto applied = std::make_shared<TableReader::Overrides>();
-  for (const std::string& o : overrides) {
-    detail::applyOverride(table, o);
-    (*applied)[o.substr(0, o.find('='))] = o;
-  }
+  for (const std::string& o : overrides) (*applied)[detail::applyOverride(table, o)] = o;
   Scene scene = readScene(table, base_dir, applied);
   std::ostringstream effective;
   effective << table;
@@ -104,6 +102,10 @@ Scene loadSceneText(const std::string& text, const std::string& source_name,
 }
 
 Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  // A folder opens as an empty file on Linux: the reader would say "missing [scene]".
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(path.string() + ": is a directory, not a scene file (give a .toml file or a built-in name)");
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open the scene file (does it exist?)");
   std::stringstream buf;
@@ -114,6 +116,9 @@ Scene loadScene(const std::filesystem::path& path, const std::vector<std::string
 }
 
 std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw SceneError(path.string() + ": is a directory, not a camera file (give a .toml file with [[cameras]])");
   std::ifstream in(path);
   if (!in) throw SceneError(path.string() + ": cannot open the camera file (does it exist?)");
   std::stringstream buf;

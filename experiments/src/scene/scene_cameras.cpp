@@ -1,9 +1,28 @@
 // Scene reader: [[cameras]] (also the camera files of `rocklab render`).
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "scene/scene_internal.h"
 
 namespace rocklab::experiments::detail {
+
+namespace {
+
+/// The [[cameras]] key behind a geometry::Camera::validate message
+/// ("camera.fx must be ..."), so the message blames the key that was written.
+std::string sceneKeyOf(const std::string& message) {
+  static const std::pair<const char*, const char*> fields[] = {
+      {"camera.width", "resolution"}, {"camera.height", "resolution"}, {"camera.fx", "fx"},
+      {"camera.fy", "fy"},           {"camera.cx", "cx"},              {"camera.cy", "cy"},
+      {"camera.k1", "k1"},           {"camera.k2", "k2"},              {"camera.frameRate", "frame_rate"},
+      {"camera.exposureTime", "exposure"}, {"camera.rotation", "up"},  {"camera.translation", "eye"}};
+  for (const auto& [field, key] : fields)
+    if (message.rfind(std::string(field) + " ", 0) == 0) return key;
+  return "exposure";
+}
+
+}  // namespace
 
 /// [[cameras]]: intrinsics (fov_deg, or fx/fy/cx/cy), pose (eye, target, up),
 /// timing and outputs. Every camera field is checked by
@@ -38,6 +57,8 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     cam.frameRate = t.number("frame_rate", 500.0, Range::positive());
     cam.exposureTime = t.number("exposure", 0.0, Range::nonNegative());
     const Vec3 eye = t.requiredVec3("eye"), target = t.requiredVec3("target");
+    // lookAt throws for either of two keys: say which.
+    if (!((target - eye).norm() > 0)) t.fail("eye", "equals target: the camera must look at a point away from it");
     try {
       cam.lookAt(eye, target, t.vec3("up", Vec3::UnitZ()));
     } catch (const std::invalid_argument& e) {
@@ -46,7 +67,7 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     try {
       cam.validate();
     } catch (const std::invalid_argument& e) {
-      t.fail("exposure", e.what());
+      t.fail(sceneKeyOf(e.what()), e.what());
     }
     c.start_time = t.number("start_time", c.start_time, Range::nonNegative());
     c.end_time = t.number("end_time", c.end_time, Range::positive());

@@ -8,7 +8,10 @@ namespace rocklab::experiments::detail {
 
 namespace {
 
-sim::Material readMaterial(TableReader t, const std::string& name) {
+/// One material; what its contact law needs (kn > 0 for the linear law, a shear
+/// modulus for Hertz-Mindlin) is checked here, where the message can name the
+/// key and its line (the World would say only "material 'rock'").
+sim::Material readMaterial(TableReader t, const std::string& name, sim::ContactLaw law) {
   sim::Material m;
   m.name = name;
   m.density = t.number("density", m.density, Range::positive());
@@ -17,6 +20,10 @@ sim::Material readMaterial(TableReader t, const std::string& name) {
   m.friction = t.number("friction", m.friction, Range::nonNegative());
   m.shear_modulus = t.number("shear_modulus", m.shear_modulus, Range::nonNegative());
   m.poisson = t.number("poisson", m.poisson, {-1.0, 0.5, true, true});
+  if (law == sim::ContactLaw::Linear && !(m.kn > 0))
+    t.fail("kn", "the linear contact law needs kn > 0 N/m (contact.law = \"linear\" is the default)");
+  if (law == sim::ContactLaw::HertzMindlin && !(m.shear_modulus > 0))
+    t.fail("shear_modulus", "contact.law = \"hertz_mindlin\" needs shear_modulus > 0 Pa");
   t.finish();
   return m;
 }
@@ -44,11 +51,15 @@ std::map<std::string, int> readMaterials(TableReader& root, Scene& scene) {
   std::map<std::string, int> materials;
   auto t = root.table("materials");
   if (!t) root.fail("materials", "missing; define at least one [materials.NAME] table");
+  // The law the materials must suit; readContact checks the key itself.
+  const toml::node* law_node = root.raw().at_path("contact.law").node();
+  const auto law = law_node && law_node->value<std::string>() == "hertz_mindlin" ? sim::ContactLaw::HertzMindlin
+                                                                                 : sim::ContactLaw::Linear;
   for (const std::string& name : t->keys()) {
     auto mt = t->table(name);
     materials[name] = static_cast<int>(model.materials.size());
     scene.material_colours.push_back(readColour(*mt, "colour", render::kGreyPebble));
-    model.materials.push_back(readMaterial(*mt, name));
+    model.materials.push_back(readMaterial(*mt, name, law));
   }
   if (model.materials.empty()) root.fail("materials", "define at least one [materials.NAME] table");
   t->finish();
@@ -79,12 +90,6 @@ void readContact(TableReader& root, sim::Model& model) {
     }
     t->finish();
   }
-  if (model.contact.law == sim::ContactLaw::HertzMindlin)
-    for (const auto& m : model.materials)
-      if (!(m.shear_modulus > 0))
-        root.fail("materials", "material '" + m.name +
-                                   "' needs shear_modulus > 0 Pa for "
-                                   "contact.law = \"hertz_mindlin\"");
 }
 
 }  // namespace rocklab::experiments::detail

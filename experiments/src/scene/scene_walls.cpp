@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "rocklab/geometry/mesh_import.h"
+#include "rocklab/sim/wall_motion.h"
 #include "scene/scene_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -61,8 +62,8 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
     } else if (type == "polygon") {
       w.shape = sim::WallShape::Polygon;
       w.vertices = t.vec3List("vertices");
-      if (w.vertices.size() < 3)
-        t.fail("vertices", "a polygon needs at least 3 vertices [[x,y,z], ...]");
+      if (const std::string problem = sim::polygonProblem(w.vertices); !problem.empty())
+        t.fail("vertices", problem + " ([[x, y, z], ...])");
       model.walls.push_back(w);
     } else if (type == "plate") {
       // A rectangle from `corner`: `length` along x turned up by angle_deg

@@ -7,13 +7,28 @@
 
 namespace rocklab::experiments::detail {
 
+std::string numberText(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buffer[64];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+  return std::string(buffer, end);
+}
+
 namespace {
+/// A value as messages print it: strings quoted, numbers as short as they read
+/// back (toml++ itself prints 17 digits: -0.0040000000000000001).
 std::string fmtValue(const toml::node& n) {
   std::ostringstream s;
   if (auto str = n.as_string()) s << '"' << str->get() << '"';
+  else if (auto f = n.as_floating_point()) s << numberText(f->get());
   else if (n.is_table()) s << "a table";
   else if (n.is_array_of_tables()) s << "an array of tables";
-  else n.visit([&s](const auto& v) { s << v; });
+  else if (auto a = n.as_array()) {
+    s << '[';
+    for (std::size_t k = 0; k < a->size(); ++k) s << (k ? ", " : "") << fmtValue(*a->get(k));
+    s << ']';
+  } else n.visit([&s](const auto& v) { s << v; });
   return s.str();
 }
 std::string typeName(const toml::node& n) {
@@ -41,13 +56,6 @@ bool toVec3(const toml::node& n, geometry::Vec3& out) {
   for (int k = 0; k < 3; ++k)
     if (!toNumber(*a->get(static_cast<std::size_t>(k)), out[k])) return false;
   return true;
-}
-/// The shortest text that reads back as `v` ("0.3", "2650", "1e-06", "inf").
-std::string numberText(double v) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buffer[64];
-  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
-  return std::string(buffer, end);
 }
 std::string vecText(const geometry::Vec3& v) {
   return "[" + numberText(v.x()) + ", " + numberText(v.y()) + ", " + numberText(v.z()) + "]";
@@ -114,6 +122,8 @@ std::string Range::describe() const {
 
 std::string where(const toml::source_region& src) {
   std::ostringstream s;
+  // No path: a node made in memory (a table a --set created; TableReader::origin
+  // names the override instead).
   const std::string file = src.path ? *src.path : std::string("<scene>");
   s << file;
   if (file.rfind("--set", 0) != 0 && src.begin.line > 0) s << ':' << src.begin.line;
@@ -123,7 +133,7 @@ std::string where(const toml::source_region& src) {
 
 TableReader::TableReader(const toml::table& table, std::string path,
                          std::shared_ptr<const Overrides> overrides)
-    : table_(&table), path_(std::move(path)), overrides_(std::move(overrides)) {
+    : table_(&table), path_(std::move(path)), label_(path_), overrides_(std::move(overrides)) {
   // The documentation table: the dotted path without array indices.
   std::stringstream parts(path_);
   std::string part;
@@ -133,18 +143,30 @@ TableReader::TableReader(const toml::table& table, std::string path,
 }
 
 std::string TableReader::keyPath(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
+  return label_.empty() ? key : label_ + "." + key;
+}
+
+std::string TableReader::origin(const std::string& key, const toml::source_region& src) const {
+  const std::string indexed = path_.empty() ? key : path_ + "." + key;
+  if (overrides_) {
+    if (const auto over = overrides_->find(indexed); over != overrides_->end()) return "--set " + over->second + ": ";
+    // A table only a --set made has no source: name the override inside it.
+    if (!src.path)
+      for (const std::string& table : {indexed, path_}) {
+        if (table.empty()) continue;
+        const auto inside = overrides_->lower_bound(table + ".");
+        if (inside != overrides_->end() && inside->first.rfind(table + ".", 0) == 0)
+          return "--set " + inside->second + ": ";
+      }
+  }
+  return where(src);
 }
 
 void TableReader::fail(const std::string& key, const std::string& what) const {
   const toml::node* n = table_->get(key);
   const toml::source_region& src = n ? n->source() : table_->source();
   std::ostringstream s;
-  const auto over = overrides_ ? overrides_->find(keyPath(key)) : Overrides::const_iterator{};
-  if (overrides_ && over != overrides_->end())
-    s << "--set " << over->second << ": ";
-  else
-    s << where(src);
+  s << origin(key, src);
   s << "key '" << keyPath(key) << "'";
   if (n) s << " = " << fmtValue(*n);
   s << ": " << what;
@@ -347,7 +369,8 @@ std::optional<TableReader> TableReader::table(const std::string& key) {
   if (!n) return std::nullopt;
   auto t = n->as_table();
   if (!t) fail(key, "expected a table ([" + keyPath(key) + "]), got " + typeName(*n));
-  TableReader child(*t, keyPath(key), overrides_);
+  TableReader child(*t, path_.empty() ? key : path_ + "." + key, overrides_);
+  child.label_ = keyPath(key);
   child.doc_table_ = (doc_table_.empty() ? "" : doc_table_ + ".") + (named_entries_ ? "NAME" : key);
   return child;
 }
@@ -359,8 +382,25 @@ std::vector<TableReader> TableReader::tableArray(const std::string& key) {
   if (!n) return out;
   auto a = n->as_array();
   if (!a || !a->is_array_of_tables()) fail(key, "expected an array of tables ([[" + keyPath(key) + "]])");
+  // An entry is named in messages as --set addresses it: by its `name` when no
+  // other entry has that name and it reads as a key part, else by its index.
+  const auto entryName = [a](std::size_t k) -> std::string {
+    const auto name = a->get(k)->as_table()->get("name");
+    const auto text = name ? name->value<std::string>() : std::nullopt;
+    if (!text || text->empty() || text->find_first_of(". \t\"'=[]") != std::string::npos ||
+        text->find_first_not_of("0123456789") == std::string::npos)
+      return {};
+    for (std::size_t e = 0; e < a->size(); ++e)
+      if (const auto other = a->get(e)->as_table()->get("name");
+          e != k && other && other->value<std::string>() == text)
+        return {};
+    return *text;
+  };
+  const std::string indexed = path_.empty() ? key : path_ + "." + key;
   for (std::size_t k = 0; k < a->size(); ++k) {
-    out.emplace_back(*a->get(k)->as_table(), keyPath(key) + "." + std::to_string(k), overrides_);
+    out.emplace_back(*a->get(k)->as_table(), indexed + "." + std::to_string(k), overrides_);
+    const std::string name = entryName(k);
+    out.back().label_ = keyPath(key) + "." + (name.empty() ? std::to_string(k) : name);
     out.back().doc_table_ = (doc_table_.empty() ? "" : doc_table_ + ".") + key;
   }
   return out;
@@ -380,18 +420,14 @@ void TableReader::finish() const {
     std::string allowed;
     for (const auto& u : used_) allowed += (allowed.empty() ? "" : ", ") + u;
     std::ostringstream s;
-    const auto over = overrides_ ? overrides_->find(keyPath(key)) : Overrides::const_iterator{};
-    if (overrides_ && over != overrides_->end())
-      s << "--set " << over->second << ": ";
-    else
-      s << where(v.source());
+    s << origin(key, v.source());
     s << "unknown key '" << keyPath(key) << "'";
     if (!allowed.empty()) s << "; known keys here: " << allowed;
     throw SceneError(s.str());
   }
 }
 
-void applyOverride(toml::table& root, const std::string& assignment) {
+std::string applyOverride(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
     throw SceneError("--set " + assignment + ": expected key=value, e.g. --set timestep.dt=1e-6");
@@ -413,12 +449,20 @@ void applyOverride(toml::table& root, const std::string& assignment) {
       throw SceneError("--set " + assignment + ": the value is not valid TOML");
     }
   }
-  // Walk the dotted path; numeric parts index arrays of tables.
-  toml::node* cur = &root;
-  std::string part;
+  // Walk the dotted path; numeric parts index arrays of tables. Every part must
+  // be a name: "scene.=1" would otherwise replace [scene] itself.
   std::vector<std::string> parts;
-  std::stringstream ss(key);
-  while (std::getline(ss, part, '.')) parts.push_back(part);
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+    if (parts.back().empty())
+      throw SceneError("--set " + assignment + ": the key has an empty part; write TABLE.KEY=VALUE, e.g. "
+                       "--set scene.end_time=0.5");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  toml::node* cur = &root;
+  std::string indexed;  // the key with array indices, for the messages of the readers
   for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
     if (auto t = cur->as_table()) {
       toml::node* next = t->get(parts[k]);
@@ -427,6 +471,7 @@ void applyOverride(toml::table& root, const std::string& assignment) {
         next = t->get(parts[k]);
       }
       cur = next;
+      indexed += parts[k] + ".";
     } else if (auto a = cur->as_array()) {
       // An index, or the name of an entry (walls.gate.active_until = ...).
       std::size_t idx = a->size();
@@ -435,24 +480,37 @@ void applyOverride(toml::table& root, const std::string& assignment) {
             entry && entry->get("name") && entry->get("name")->value<std::string>() == parts[k])
           idx = e;
       if (idx == a->size()) {
-        try {
-          idx = std::stoul(parts[k]);
-        } catch (...) {
+        if (parts[k].find_first_not_of("0123456789") != std::string::npos)
           throw SceneError("--set " + assignment + ": '" + parts[k] +
                            "' must be an index into the array or the name of one of its entries");
-        }
+        idx = parts[k].size() > 9 ? a->size() : std::stoul(parts[k]);
+        if (idx >= a->size())
+          throw SceneError("--set " + assignment + ": index " + parts[k] + " is beyond the " +
+                           std::to_string(a->size()) + " entries");
       }
-      if (idx >= a->size())
-        throw SceneError("--set " + assignment + ": index " + parts[k] + " is beyond the " +
-                         std::to_string(a->size()) + " entries");
       cur = a->get(idx);
+      indexed += std::to_string(idx) + ".";
     } else {
       throw SceneError("--set " + assignment + ": '" + parts[k] + "' is not a table");
     }
   }
   auto t = cur->as_table();
-  if (!t) throw SceneError("--set " + assignment + ": the parent of the last key is not a table");
-  t->insert_or_assign(parts.back(), *parsed.get("v"));
+  if (!t) {
+    const std::string parent = key.substr(0, key.rfind('.'));
+    if (cur->is_array_of_tables())
+      throw SceneError("--set " + assignment + ": '" + parent + "' is an array of tables; set a key of one entry, e.g. --set " +
+                       parent + ".0.KEY=VALUE");
+    throw SceneError("--set " + assignment + ": '" + parent + "' is " + typeName(*cur) + ", not a table");
+  }
+  // A table is changed key by key: a number or string in its place would drop
+  // all of it ([[walls]] may be replaced by another array, e.g. []).
+  const toml::node& new_value = *parsed.get("v");
+  if (const toml::node* old = t->get(parts.back());
+      old && ((old->is_table() && !new_value.is_table()) || (old->is_array_of_tables() && !new_value.is_array())))
+    throw SceneError("--set " + assignment + ": '" + key + "' is a table; set one of its keys, e.g. --set " + key +
+                     ".KEY=VALUE");
+  t->insert_or_assign(parts.back(), new_value);
+  return indexed + parts.back();
 }
 
 }  // namespace rocklab::experiments::detail

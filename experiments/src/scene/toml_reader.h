@@ -48,9 +48,10 @@ std::vector<KeyRead> recordedSceneKeys();
 
 class TableReader {
  public:
-  /// Dotted key -> the --set assignment that gave it (messages then name the override).
+  /// Dotted key with array indices ("cameras.0.resolution", as applyOverride
+  /// returns it) -> the --set assignment that gave it (messages then name the override).
   using Overrides = std::map<std::string, std::string>;
-  /// `path` is the dotted key of this table ("" for the root), for messages.
+  /// `path` is the dotted key of this table ("" for the root), with array indices.
   TableReader(const toml::table& table, std::string path,
               std::shared_ptr<const Overrides> overrides = nullptr);
 
@@ -82,8 +83,10 @@ class TableReader {
   void finish() const;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  /// Dotted key as messages name it: an entry of an array of tables by its
+  /// `name` when it has a unique one ("cameras.side.resolution"), else by index.
   std::string keyPath(const std::string& key) const;
-  /// Dotted key of this table, e.g. "walls.2".
+  /// Dotted key of this table with array indices, e.g. "walls.2".
   const std::string& path() const { return path_; }
   const toml::table& raw() const { return *table_; }
   /// The documentation table of the keys read from now on (default: the dotted
@@ -94,6 +97,9 @@ class TableReader {
 
  private:
   const toml::node* node(const std::string& key);
+  /// Where a message about `key` points: "--set ASSIGNMENT: " when an override
+  /// gave the key (or made the table it sits in), else "file:line: " of `src`.
+  std::string origin(const std::string& key, const toml::source_region& src) const;
   /// Records a key read (when recording) under doc_table_.
   void note(const std::string& key, const std::string& kind, const std::string& allowed,
             const std::string& fallback) const;
@@ -104,6 +110,8 @@ class TableReader {
   std::string doc_table_;
   const toml::table* table_;
   std::string path_;
+  /// What messages call this table (path_ with named entries by name).
+  std::string label_;
   std::set<std::string> used_;
   std::shared_ptr<const Overrides> overrides_;
 };
@@ -111,6 +119,10 @@ class TableReader {
 /// "file:line: " for a node.
 std::string where(const toml::source_region& src);
 /// Sets `key.path=value` in `root`; throws SceneError naming the override.
-void applyOverride(toml::table& root, const std::string& assignment);
+/// Returns the dotted key with array indices (walls.gate.x -> walls.2.x).
+std::string applyOverride(toml::table& root, const std::string& assignment);
+/// The shortest text that reads back as `v` ("0.3", "-0.004", "1e-06", "inf"):
+/// messages print what the user wrote, not 17 digits.
+std::string numberText(double v);
 
 }  // namespace rocklab::experiments::detail

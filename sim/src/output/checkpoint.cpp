@@ -376,6 +376,7 @@ Checkpoint readCheckpoint(const std::filesystem::path& path) {
   };
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw fail("file does not exist");
+  if (std::filesystem::is_directory(path, error)) throw fail("is a directory, not a checkpoint.h5");
   if (!std::filesystem::is_regular_file(path, error)) throw fail("not a regular file");
   try {
     if (!H5::H5File::isHdf5(path.string())) {

@@ -306,6 +306,7 @@ RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::mak
   const std::string where = "run file '" + path.string() + "': ";
   try {
     if (!std::filesystem::exists(path)) throw std::runtime_error(where + "does not exist");
+    if (std::filesystem::is_directory(path)) throw std::runtime_error(where + "is a directory, not a run.h5");
     if (!H5::H5File::isHdf5(path.string())) throw std::runtime_error(where + "not an HDF5 file");
     impl_->file = H5::H5File(path.string(), H5F_ACC_RDONLY);
     if (!impl_->file.nameExists("scene") || !impl_->file.nameExists("frames"))

@@ -31,8 +31,12 @@ struct TriangleMesh {
   AABB bounds() const;
   /// Closest point on the whole mesh surface (brute force over triangles).
   Vec3 closestPoint(const Vec3& p) const;
-  /// Checks indices and degenerate triangles; returns an empty string or a message.
+  /// Checks coordinates (finite), indices and degenerate triangles; returns an
+  /// empty string or a message.
   std::string validate() const;
+  /// "" or which vertex has a NaN or infinite coordinate (a NaN vertex would
+  /// otherwise read as a zero-area triangle or a flat surface).
+  std::string nonFiniteVertex() const;
 };
 
 }  // namespace rocklab::geometry

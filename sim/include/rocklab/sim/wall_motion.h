@@ -6,7 +6,9 @@
 //   x(t) = pivot + T(t) + R(t) (x0 - pivot),   T(t) = v t + A sin(2 pi f t),
 //   R(t) = rotation by |omega| t about omega  (x0: a point of the wall at rest)
 #include <cmath>
+#include <algorithm>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "rocklab/sim/model.h"
@@ -42,6 +44,20 @@ inline WallPose wallPoseAt(const WallMotion& m, double t) {
 /// (zero when they are collinear; validateModel refuses such a wall).
 inline geometry::Vec3 polygonNormal(const std::vector<geometry::Vec3>& v) {
   return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+}
+
+/// "" or why `v` is no polygon wall: fewer than 3 vertices, the first three
+/// collinear, or a vertex off their plane. One rule for validateModel and the
+/// scene reader (which can name the key and its line).
+inline std::string polygonProblem(const std::vector<geometry::Vec3>& v) {
+  if (v.size() < 3) return "a polygon needs at least 3 vertices";
+  const geometry::Vec3 normal = polygonNormal(v);
+  if (!(normal.norm() > 0)) return "the first three vertices are collinear (or repeated): they span no plane";
+  const double scale = (v[1] - v[0]).norm();
+  for (std::size_t k = 3; k < v.size(); ++k)
+    if (!(std::abs((v[k] - v[0]).dot(normal)) <= 1e-9 * std::max(1.0, scale)))
+      return "vertex " + std::to_string(k) + " is not in the plane of the first three";
+  return {};
 }
 
 }  // namespace rocklab::sim
