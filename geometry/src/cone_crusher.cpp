@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -58,12 +59,28 @@ void validateInputs(const ConeCrusherSpec& s) {
     refuse("segments", "= " + std::to_string(s.segments) + ": must be >= 3 (triangles around each frustum)");
 }
 
-/// Distance from p to the segment a-b in the section.
-double segmentDistance(SectionPoint p, SectionPoint a, SectionPoint b) {
+/// The point of the segment a-b nearest to p, in the section.
+SectionPoint nearestOnSegment(SectionPoint p, SectionPoint a, SectionPoint b) {
   const double dx = b.x - a.x, dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
   const double t = len2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+  return {a.x + t * dx, a.y + t * dy};
+}
+
+double distance(SectionPoint p, SectionPoint q) { return std::hypot(p.x - q.x, p.y - q.y); }
+
+/// The nearest pair of two segments that do not cross: one end of one and its nearest point on the other.
+SectionGap nearestPair(SectionPoint a0, SectionPoint a1, SectionPoint b0, SectionPoint b1) {
+  SectionGap best;
+  best.width = std::numeric_limits<double>::infinity();
+  auto consider = [&](SectionPoint on_a, SectionPoint on_b) {
+    if (const double d = distance(on_a, on_b); d < best.width) best = {on_a, on_b, d};
+  };
+  consider(a0, nearestOnSegment(a0, b0, b1));
+  consider(a1, nearestOnSegment(a1, b0, b1));
+  consider(nearestOnSegment(b0, a0, a1), b0);
+  consider(nearestOnSegment(b1, a0, a1), b1);
+  return best;
 }
 
 }  // namespace
@@ -142,13 +159,15 @@ ConeCrusherGeometry coneCrusherGeometry(const ConeCrusherSpec& spec) {
   // gyration later the closed-side section shows t = 0's open side, mirrored in x):
   // from the lower concave's bottom lip to the mantle's generator (the discharge).
   const SectionPoint lip{g.R_bot_c, g.O_bot_c.y}, concave_top{g.R_mid_c, g.O_mid_c.y};
-  g.closed_side_gap = std::min({segmentDistance(lip, g.mantle_bottom_edge, g.mantle_top_edge),
-                                segmentDistance(concave_top, g.mantle_bottom_edge, g.mantle_top_edge),
-                                segmentDistance(g.mantle_bottom_edge, lip, concave_top),
-                                segmentDistance(g.mantle_top_edge, lip, concave_top)});
+  g.closed_gap = nearestPair(g.mantle_bottom_edge, g.mantle_top_edge, lip, concave_top);
   const SectionPoint open_bottom{-(g.O_bot_m.x - g.R_bot_m * c), g.O_bot_m.y - g.R_bot_m * sn},
       open_top{-(g.O_top_m.x - g.R_top_m * c), g.O_top_m.y - g.R_top_m * sn};
-  g.open_side_setting = segmentDistance(lip, open_bottom, open_top);
+  const SectionPoint open_foot = nearestOnSegment(lip, open_bottom, open_top);
+  g.open_gap = {open_foot, lip, distance(open_foot, lip)};
+  g.closed_side_gap = g.closed_gap.width;
+  g.open_side_setting = g.open_gap.width;
+  g.open_mantle_bottom_edge = open_bottom;
+  g.open_mantle_top_edge = open_top;
   return g;
 }
 

@@ -54,6 +54,12 @@ struct SectionPoint {
   Vec3 world() const { return {x, 0.0, y}; }
 };
 
+/// A gap of the section: from a point of the mantle to a point of the concave.
+struct SectionGap {
+  SectionPoint mantle, concave;
+  double width = 0;  // m
+};
+
 /// Every derived quantity, in metres and radians unless named _deg.
 struct ConeCrusherGeometry {
   ConeCrusherSpec spec;
@@ -79,6 +85,8 @@ struct ConeCrusherGeometry {
   // and lower concave at t = 0 (the CSS the chamber really has), and the open-side
   // setting, from the lower concave's bottom lip to the mantle half a gyration later.
   double closed_side_gap = 0;  // m
+  SectionGap closed_gap, open_gap;  // where they are measured
+  SectionPoint open_mantle_bottom_edge, open_mantle_top_edge;  // closed-side section half a gyration later
   double open_side_setting = 0;  // m
 };
 
