@@ -56,7 +56,7 @@ TEST_CASE("[crusher] builds the Table 6.1 chamber as mesh walls and refuses bad 
   CHECK_THAT(loadError({"crusher.spin_sense=\"backwards\""}), Contains("opposite"));
 }
 
-TEST_CASE("crusher-geometry prints, draws the section and writes results.json; no [crusher] is bad input",
+TEST_CASE("crusher-geometry prints, draws the section and writes results.json, and a scene without [crusher] is bad input",
           "[cli][crusher]") {
   const fs::path out = fs::temp_directory_path() / ("rocklab-crusher-" + std::to_string(::getpid()));
   fs::remove_all(out);
