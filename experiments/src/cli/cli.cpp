@@ -15,6 +15,7 @@
 #include "agglomerate/agglomerate_cli.h"
 #include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
+#include "crusher/crusher_geometry_command.h"
 #include "camera/render_run.h"
 #include "common/json_text.h"
 #include "common/quiet_log.h"
@@ -52,6 +53,7 @@ Examples:
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
   rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
+  rocklab crusher-geometry cone-crusher --set crusher.css=0.012   # chamber quantities + section.png
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -249,6 +251,11 @@ void addCommands(CLI::App& app, CliArgs& a) {
   check->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
   check->add_option("--set", a.overrides, "Override a scene key")->take_all();
   app.add_subcommand("list", "List the built-in scenes and studies");
+  auto* crusher = app.add_subcommand(
+      "crusher-geometry", "Print a cone crusher scene's derived chamber (Eq 6-1..6-9) and draw its closed-side section");
+  crusher->add_option("scene", a.scene_arg, "Scene TOML file or built-in name with a [crusher] table")->required();
+  crusher->add_option("--set", a.overrides, "Override a scene key, e.g. --set crusher.css=0.012")->take_all();
+  crusher->add_option("--out", a.out_dir, "Output directory for section.png and results.json (default: out/<scene name>-geometry)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -499,6 +506,8 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
   if (const auto subcommands = app.get_subcommands(); !subcommands.empty()) name = "rocklab " + subcommands.front()->get_name();
 
   if (app.got_subcommand("list")) return doList();
+  if (app.got_subcommand("crusher-geometry"))
+    return runCrusherGeometry({a.scene_arg, a.overrides, a.out_dir}, std::cout, std::cerr);
   if (app.got_subcommand("scene-keys")) return doSceneKeys(a.collect_dir);
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("weibull")) {

@@ -28,6 +28,7 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   detail::readGravity(root, scene.model);
   detail::readEngine(root, scene.model);
   detail::readWalls(root, materials, base_dir, scene.model, scene.wall_looks);
+  detail::readCrusher(root, materials, scene);
   detail::readParticles(root, materials, scene.model.materials, scene.run.seed, base_dir, scene);
   detail::readBonds(root, scene.run.seed, scene);
   detail::readCameras(root, scene.cameras);

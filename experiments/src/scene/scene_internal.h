@@ -4,7 +4,7 @@
 // ([scene], [output]), scene_materials.cpp ([materials.NAME], [contact]),
 // scene_engine.cpp
 // ([gravity], [timestep], [neighbours], [watchdog], [relaxation]),
-// scene_walls.cpp ([[walls]]), scene_particles.cpp ([[particles]]),
+// scene_walls.cpp ([[walls]]), scene_crusher.cpp ([crusher]), scene_particles.cpp ([[particles]]),
 // scene_cameras.cpp ([[cameras]]), scene_experiment.cpp ([experiment]).
 // Each reads its keys with the TableReader (file:line messages) in the order
 // readScene calls them, which is the order of the messages.
@@ -42,6 +42,9 @@ void readEngine(TableReader& root, sim::Model& model);
 void readWalls(TableReader& root, const std::map<std::string, int>& materials,
                const std::filesystem::path& base_dir, sim::Model& model,
                std::vector<WallLook>& looks);
+/// [crusher]: the cone crusher's chamber and motion into scene.crusher, its
+/// walls appended to the model (scene_crusher.cpp).
+void readCrusher(TableReader& root, const std::map<std::string, int>& materials, Scene& scene);
 void readParticles(TableReader& root, const std::map<std::string, int>& materials,
                    const std::vector<sim::Material>& material_list, std::uint64_t seed,
                    const std::filesystem::path& base_dir, Scene& scene);

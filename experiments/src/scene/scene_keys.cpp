@@ -29,6 +29,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"", "watchdog", "", "[watchdog]: the stability checks that stop a run."},
       {"", "relaxation", "", "[relaxation]: easing apart the overlaps a scene starts with."},
       {"", "walls", "", "[[walls]]: the walls, one table each."},
+      {"", "crusher", "", "[crusher]: a cone crusher's chamber and mantle motion (docs/crusher.md)."},
       {"", "particles", "", "[[particles]]: the particle sources, one table each."},
       {"", "bonds", "", "[bonds]: the parallel bonds of the agglomerates (required with agglomerates)."},
       {"", "cameras", "", "[[cameras]]: virtual cameras that film the run."},
@@ -94,6 +95,24 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       // --- [relaxation]
       {"relaxation", "", "", "Initial overlaps kept as offsets that shrink to zero, so overlapping bodies are eased apart."},
       {"relaxation", "steps", "", "Steps over which the initial overlaps are relaxed; 0 = off."},
+
+      // --- [crusher]
+      {"crusher", "", "", "Cone crusher of experiments.md §g (Table 6.1; the baseline by default). Adds its walls as static mesh walls crusher.mantle, .mantle_cap, .lower_concave, .upper_concave; `rocklab crusher-geometry SCENE` prints the derived chamber (docs/crusher.md)."},
+      {"crusher", "feed_opening", "m", "F: width of the chamber's feed opening; must exceed css."},
+      {"crusher", "css", "m", "CSS: closed-side setting, the nominal smallest mantle-concave gap; below feed_opening."},
+      {"crusher", "throw", "m", "s: eccentric travel of the cone in half a revolution."},
+      {"crusher", "bite_angle_deg", "deg", "beta: angle between the upper concave and the mantle."},
+      {"crusher", "cone_angle_deg", "deg", "alpha: cone angle at the base of the mantle."},
+      {"crusher", "eccentric_angle_deg", "deg", "gamma: tilt of the mantle axis (below cone_angle_deg)."},
+      {"crusher", "parallel_length", "m", "delta_l: length of the lower concave, parallel to the mantle at the CSS position."},
+      {"crusher", "mantle_diameter", "m", "D_c: bottom diameter of the mantle."},
+      {"crusher", "mantle_top_x", "", "x of the mantle's top centre O_top_m: the [R]-corrected R_top_c - F sin(alpha-gamma) - cos(gamma) R_top_m, or as printed (without the F term)."},
+      {"crusher", "pivot", "", "The [X] pivot reading: axis = (A) Eq 6-2..6-8 as printed, pivot at s/sin(gamma) on the crusher axis; eq6-1 = (B) Eq 6-1's h with the mantle's bottom centre s/2 off the axis."},
+      {"crusher", "segments", "", "Triangles around each frustum wall (x 2 for a frustum): the mesh resolution."},
+      {"crusher", "eccentric_speed_rpm", "rpm", "Gyration speed omega_ecc of the mantle about the crusher axis; the spin follows by Eq 6-9."},
+      {"crusher", "spin_sense", "", "Spin of the mantle about its own axis: opposite to the gyration (rolls on the feed at the closed side), same, or none."},
+      {"crusher", "material", "", "Material of the crusher walls.", "a name under [materials]"},
+      {"crusher", "walls", "", "Add the chamber walls (mantle, cap, lower and upper concave) to the scene's walls."},
 
       // --- [[walls]]
       {"walls", "", "", "A wall: plane, polygon, plate, mesh or box, with prescribed motion and an active time window. Keys by type are marked (plane), (polygon), ..."},

@@ -5,11 +5,14 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "rocklab/geometry/camera.h"
+#include "rocklab/geometry/cone_crusher.h"
+#include "rocklab/geometry/mantle_motion.h"
 #include "rocklab/render/frame.h"
 #include "rocklab/sim/model.h"
 
@@ -105,6 +108,18 @@ struct WallLook {
   double plane_thickness = 0.0;  // m, 0 = a flat polygon
 };
 
+/// The cone crusher of a scene ([crusher], experiments.md §g): its chamber
+/// (geometry/cone_crusher.h) and mantle motion (geometry/mantle_motion.h). Its
+/// walls are added to the model as static mesh walls named crusher.mantle,
+/// crusher.mantle_cap, crusher.lower_concave, crusher.upper_concave: the engine
+/// cannot move the mantle yet (the spin is not a WallMotion; docs/crusher.md).
+struct CrusherSettings {
+  geometry::ConeCrusherSpec spec;
+  double eccentric_rpm = 300.0;  // rpm, gyration speed (omega_ecc)
+  geometry::SpinSense spin_sense = geometry::SpinSense::Opposite;
+  int material = 0;              // index of the walls' material
+};
+
 struct Scene {
   std::filesystem::path source;  // file it came from ("" for text)
   std::string text;              // effective TOML (overrides applied), stored with outputs
@@ -120,6 +135,7 @@ struct Scene {
   std::vector<CameraSettings> cameras;
   std::vector<WallLook> wall_looks;             // one per model wall
   std::vector<render::Rgb> material_colours;    // one per material (balls)
+  std::optional<CrusherSettings> crusher;       // [crusher], when the scene has one
 };
 
 /// Parses and validates a scene. `overrides` are "key.path=value" strings
