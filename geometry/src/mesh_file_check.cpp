@@ -449,12 +449,12 @@ void checkObj(std::string_view text) {
 }  // namespace
 
 std::string meshFileProblem(const std::string& path) {
-  const std::string ext = lower(std::filesystem::path(path).extension().string());
-  if (ext != ".stl" && ext != ".ply" && ext != ".obj")
-    return "unknown extension '" + ext + "': STL, PLY and OBJ files are read (.stl, .ply, .obj)";
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return "does not exist";
   if (std::filesystem::is_directory(path, ec)) return "is a directory, not a mesh file";
+  const std::string ext = lower(std::filesystem::path(path).extension().string());
+  if (ext != ".stl" && ext != ".ply" && ext != ".obj")
+    return "unknown extension '" + ext + "': STL, PLY and OBJ files are read (.stl, .ply, .obj)";
   std::ifstream in(path, std::ios::binary);
   if (!in) return "cannot be opened for reading";
   const auto size = std::filesystem::file_size(path, ec);

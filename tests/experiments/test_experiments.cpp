@@ -94,8 +94,12 @@ TEST_CASE("heap: a small heap of clumps stands at a non-zero angle", "[experimen
   INFO(r.dump(2));
   REQUIRE(r["angle_of_repose_deg"].is_number());
   const double angle = r["angle_of_repose_deg"].get<double>();
-  CHECK(angle > 10.0);
-  CHECK(angle < 40.0);
+  // This heap (250 softened clumps) over seeds 1, 3, 4, 5: 16.1, 19.5, 16.0, 14.9 deg
+  // (mean 16.6, sd 2.0; seed 2 leaves one flank too low to be called a heap, and says
+  // so): the band is the mean +- 3 sd of that scatter (`rocklab sweep heap --vary
+  // scene.seed=1,2,3,4,5` with this test's --set values).
+  CHECK(angle > 10.6);
+  CHECK(angle < 22.6);
   CHECK(r["heap"]["flank_angles_deg"].size() == 4);
   // The side photograph (rendered, measured like a lab photo) agrees with the
   // angle from the positions within a few degrees.

@@ -88,8 +88,8 @@ TEST_CASE("a run of one step reports a stepping time >= 0", "[cli]") {
   // were subtracted from a loop that did not contain them.
   const fs::path out = tempDir("one-step");
   for (int k = 0; k < 3; ++k) {
-    REQUIRE(cli({"run", kHopper, "--quiet", "--out", out.string(), "--set", "particles.0.count=200", "--set",
-                 "scene.end_time=0", "--set", "scene.steps=1"}) == 0);
+    REQUIRE(cli({"run", kHopper, "--quiet", "--overwrite", "--out", out.string(), "--set", "particles.0.count=200",
+                 "--set", "scene.end_time=0", "--set", "scene.steps=1"}) == 0);
     const auto r = results(out);
     CHECK(r["wall_time_s"]["stepping"].get<double>() >= 0);
     CHECK(r["particle_steps_per_s"].get<double>() >= 0);
