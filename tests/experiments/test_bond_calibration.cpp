@@ -34,19 +34,24 @@ json readJson(const fs::path& file) {
   return json::parse(in);
 }
 
-}  // namespace
-
-TEST_CASE("calibrate-bonds: each trial scales B by sigma0 / sigma, the batch is fitted", "[experiment][zwick]") {
+/// A 16 mm HCP agglomerate in a random orientation, closed fast: seconds a run.
+BondCalibrationOptions fastHcpCalibration(const std::string& name) {
   BondCalibrationOptions c;
   c.runs.scene = kZwickHcp;
-  // A 16 mm HCP agglomerate closed fast: seconds a run.
   c.runs.overrides = {"particles.0.diameter=0.016", "particles.0.position=[0,0,0.009]",
                       "experiment.platen_speed=0.05", "experiment.sample_interval=1e-5",
                       "particles.0.orientation=\"random\""};
-  c.runs.out_dir = scratch("calibrate-bonds");
+  c.runs.out_dir = scratch(name);
   c.runs.jobs = 0;
   c.runs.threads = 1;
   c.runs.progress = false;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("calibrate-bonds: each trial scales B by sigma0 / sigma, the batch is fitted", "[experiment][zwick]") {
+  BondCalibrationOptions c = fastHcpCalibration("calibrate-bonds");
   c.target = {"given", 20.0, 0.0, 0.0, 3.0};
   c.trial_strength_Pa = 60e6;
   c.max_trials = 2;
@@ -85,15 +90,7 @@ TEST_CASE("calibrate-bonds: each trial scales B by sigma0 / sigma, the batch is 
 }
 
 TEST_CASE("calibrate-bonds: trials over orientations take their spread out of the bonds'", "[experiment][zwick]") {
-  BondCalibrationOptions c;
-  c.runs.scene = kZwickHcp;
-  c.runs.overrides = {"particles.0.diameter=0.016", "particles.0.position=[0,0,0.009]",
-                      "experiment.platen_speed=0.05", "experiment.sample_interval=1e-5",
-                      "particles.0.orientation=\"random\""};
-  c.runs.out_dir = scratch("calibrate-bonds-orient");
-  c.runs.jobs = 0;
-  c.runs.threads = 1;
-  c.runs.progress = false;
+  BondCalibrationOptions c = fastHcpCalibration("calibrate-bonds-orient");
   const double lab_m = 3.0;
   c.target = {"given", 20.0, 0.0, 0.0, lab_m};
   c.max_trials = 1;
