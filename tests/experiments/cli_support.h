@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -35,6 +37,12 @@ inline std::filesystem::path scratchDir(const std::string& name) {
   const std::filesystem::path d = std::filesystem::temp_directory_path() / ("rocklab-" + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   return d;
+}
+
+/// A whole file's bytes ("" when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
 }
 
 }  // namespace rocklab::experiments::test

@@ -20,15 +20,12 @@ namespace fs = std::filesystem;
 
 namespace {
 using rocklab::experiments::test::cli;
+using rocklab::experiments::test::slurp;
 fs::path tempDir(const std::string& name) {
   // The pid keeps two checkouts' suites running at once apart.
   const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), {}};
 }
 const std::string kScene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/hopper.toml";
 /// The exit code and what the command printed on stderr.

@@ -22,6 +22,7 @@ namespace fs = std::filesystem;
 using Catch::Contains;
 using nlohmann::json;
 using rocklab::experiments::test::cli;
+using rocklab::experiments::test::slurp;
 
 namespace {
 
@@ -29,10 +30,6 @@ fs::path tempDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("rocklab-harden-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
-}
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), {}};
 }
 const std::string kHopper = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/hopper.toml";
 const std::vector<std::string> kShort = {"--quiet", "--threads", "1", "--set", "particles.0.count=100", "--set",

@@ -25,16 +25,13 @@
 
 namespace fs = std::filesystem;
 using rocklab::experiments::test::cli;
+using rocklab::experiments::test::slurp;
 using rocklab::experiments::test::cliLogged;
 
 namespace {
 
 fs::path tempDir(const std::string& name) { return rocklab::experiments::test::scratchDir("damaged-" + name); }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 const std::string kHopper = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/hopper.toml";
 
