@@ -190,6 +190,22 @@ TEST_CASE("an earlier run in --out is refused without --overwrite and cleared wi
   fs::remove_all(out);
 }
 
+TEST_CASE("--skip-complete leaves a completed run as it is, before its scene is even read", "[cli]") {
+  const fs::path out = tempDir("skip");
+  REQUIRE(run(with({"run", kHopper, "--out", out.string()}, kShort)).code == 0);
+  const std::string before = listing(out);
+  // The key would be refused if the scene were loaded: the run is skipped first (a
+  // batch re-run does not rebuild a dense agglomerate for every finished run).
+  const Outcome o = run(with({"run", kHopper, "--out", out.string(), "--skip-complete", "--set", "scene.no_such_key=1"}, kShort));
+  CHECK(o.code == 0);
+  CHECK_THAT(o.err, Contains("is complete; not run again"));
+  CHECK(listing(out) == before);
+  // A folder without a completed results.json is run (here: refused for the bad key).
+  fs::remove(out / "results.json");
+  CHECK(run(with({"run", kHopper, "--out", out.string(), "--skip-complete", "--set", "scene.no_such_key=1"}, kShort)).code == 2);
+  fs::remove_all(out);
+}
+
 TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C and a second signal kills", "[cli]") {
   for (const int signal : {SIGTERM, SIGHUP}) {
     INFO("signal " << signal);

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -174,5 +175,31 @@ TEST_CASE("study --seeds: each variant runs once per seed and the table gives me
   CHECK(study["seeds"] == 3);
   CHECK(study["variants"][0]["runs"].size() == 3);
   CHECK(study["recommendation"].get<std::string>().find("the seeds cannot tell them apart") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and says so", "[plan][cli]") {
+  // Slurm's SIGTERM or a `kill` reaches the sweep's process only (its runs are process
+  // groups of their own); it passes the stop on, so no run goes on orphaned.
+  const fs::path dir = fresh("stop");
+  const auto before = std::signal(SIGTERM, SIG_DFL);
+  std::signal(SIGTERM, before);
+  std::thread sender([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    std::raise(SIGTERM);
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  const int code = cli({"sweep", "hopper", "--vary", "contact.damping_normal=0.1,0.2", "--set", "scene.end_time=100",
+                        "--jobs", "2", "--out", dir.string(), "--quiet"});
+  sender.join();
+  CHECK(code == 130);
+  CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60));  // not 100 s of hopper each
+  for (const char* run : {"contact.damping_normal=0.1", "contact.damping_normal=0.2"}) {
+    INFO(run);
+    const nlohmann::json r = nlohmann::json::parse(rocklab::experiments::test::slurp(dir / "runs" / run / "results.json"));
+    CHECK(r["status"] == "interrupted");
+    CHECK(lines(dir / "logs" / (std::string(run) + ".exit")) == std::vector<std::string>{"130"});
+  }
+  CHECK(std::signal(SIGTERM, before) == before);
   fs::remove_all(dir);
 }

@@ -429,8 +429,19 @@ int calibrateBondsCommand(const CliArgs& a) {
   return runBondCalibration(c, std::cerr);
 }
 
+/// True (and says so) when DIR holds the results.json of a completed run.
+bool isCompleteRun(const std::filesystem::path& dir) {
+  if (detail::resultStatus(detail::readJsonFile(dir / "results.json")) != "completed") return false;
+  std::cerr << "rocklab: " << (dir / "results.json").string() << " is complete; not run again\n";
+  return true;
+}
+
 /// run, demo, restart and check: one scene, loaded and checked, then run.
 int sceneCommand(const CliArgs& a, const std::string& command) {
+  // A finished run named by --out is skipped before its scene is loaded: loading may
+  // build a dense agglomerate (seconds to tens of seconds), which a batch re-run of
+  // hundreds of finished runs should not pay.
+  if (a.skip_complete && !a.out_dir.empty() && isCompleteRun(a.out_dir)) return kExitOk;
   Scene scene;
   RunOptions options;
   options.threads = a.threads;
@@ -470,12 +481,7 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
   }
 
   options.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / scene.run.name : std::filesystem::path(a.out_dir);
-  if (a.skip_complete) {
-    if (detail::resultStatus(detail::readJsonFile(options.out_dir / "results.json")) == "completed") {
-      std::cerr << "rocklab: " << (options.out_dir / "results.json").string() << " is complete; not run again\n";
-      return kExitOk;
-    }
-  }
+  if (a.skip_complete && isCompleteRun(options.out_dir)) return kExitOk;
   const StopOnSignals stop_on_signals;
   detail::QuietLogBuffer quiet(std::cerr);
   std::ostream quiet_log(&quiet);

@@ -1,5 +1,6 @@
 #include "sets/run_plan.h"
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <ostream>
 #include <sstream>
 #include <cerrno>
+#include <csignal>
 #include <thread>
 
 #include "common/atomic_file.h"
@@ -94,6 +96,32 @@ void writeExit(const fs::path& set_dir, const std::string& name, int code) {
   writeAtomically(set_dir / "logs" / (name + ".exit"), std::to_string(code) + "\n");
 }
 
+/// One run started as a child process in a process group of its own, its stdout and
+/// stderr into `log`; its pid, or -1 when it could not be started.
+pid_t spawnRun(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawnattr_t attributes;
+  posix_spawn_file_actions_init(&files);
+  posix_spawnattr_init(&attributes);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&files, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  // The child starts with the default stop-signal handlers, not this process's.
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&defaults, s);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, argv[0], &files, &attributes, argv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&files);
+  posix_spawnattr_destroy(&attributes);
+  return pid;
+}
+
 std::string clock(double seconds) {
   const long s = std::lround(std::max(0.0, seconds));
   char text[32];
@@ -131,12 +159,21 @@ std::vector<PlannedRun> planRuns(const SweepOptions& o) {
   return runs;
 }
 
+std::vector<std::string> runArguments(const fs::path& set_dir, const std::string& scene_path, const PlannedRun& run) {
+  std::vector<std::string> args = {selfExecutable().string(), "run",    scene_path,        "--out",
+                                   (fs::absolute(set_dir) / "runs" / run.name).string(), "--threads",
+                                   "1",          "--quiet", "--skip-complete", "--overwrite"};
+  for (const std::string& s : run.overrides) {
+    args.push_back("--set");
+    args.push_back(s);
+  }
+  return args;
+}
+
 std::string runCommand(const fs::path& set_dir, const std::string& scene_path, const PlannedRun& run) {
-  const fs::path dir = fs::absolute(set_dir);
-  std::string line = shellQuote(selfExecutable().string()) + " run " + shellQuote(scene_path) + " --out " +
-                     shellQuote((dir / "runs" / run.name).string()) + " --threads 1 --quiet --skip-complete --overwrite";
-  for (const std::string& s : run.overrides) line += " --set " + shellQuote(s);
-  const fs::path logs = dir / "logs";
+  std::string line;
+  for (const std::string& a : runArguments(set_dir, scene_path, run)) line += (line.empty() ? "" : " ") + shellQuote(a);
+  const fs::path logs = fs::absolute(set_dir) / "logs";
   line += " > " + shellQuote((logs / (run.name + ".log")).string()) + " 2>&1; echo $? > " +
           shellQuote((logs / (run.name + ".exit")).string());
   return line;
@@ -288,18 +325,24 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
     if (done > 0) line << ", ETA " << clock(elapsed / static_cast<double>(done) * static_cast<double>(left));
     log << line.str() << "\n";
   };
+  bool forwarded = false;
   while (next < todo.size() || !running.empty()) {
     while (!stopRequested() && next < todo.size() && static_cast<int>(running.size()) < jobs) {
       const PlannedRun* r = todo[next++];
-      const std::string line = runCommand(set_dir, scene_path, *r);
-      const char* argv[] = {"/bin/sh", "-c", line.c_str(), nullptr};
-      pid_t pid = 0;
-      if (posix_spawn(&pid, "/bin/sh", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0) {
+      const pid_t pid = spawnRun(runArguments(set_dir, scene_path, *r), set_dir / "logs" / (r->name + ".log"));
+      if (pid <= 0) {
         writeExit(set_dir, r->name, 1);
         finished(*r, 1);
         continue;
       }
       running[pid] = r;
+    }
+    // Each run is its own process group (spawnRun), out of reach of a signal sent to
+    // this one: Ctrl-C, SIGTERM or SIGHUP here is passed on once, as SIGTERM, so every
+    // run stops cleanly (checkpoint, results.json "interrupted") before the set ends.
+    if (stopRequested() && !forwarded) {
+      for (const auto& [child, run] : running) ::kill(child, SIGTERM);
+      forwarded = true;
     }
     if (running.empty()) break;
     int status = 0;
@@ -313,15 +356,15 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
       continue;
     }
     if (pid < 0) {
-      if (errno == EINTR) continue;  // Ctrl-C: the children got it too; wait for them
+      if (errno == EINTR) continue;  // a stop signal: passed on above; wait for the runs
       break;
     }
     const auto it = running.find(pid);
     if (it == running.end()) continue;
     const PlannedRun* r = it->second;
     running.erase(it);
-    int code = 1;
-    if (std::ifstream ex{set_dir / "logs" / (r->name + ".exit")}; ex) ex >> code;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    writeExit(set_dir, r->name, code);
     finished(*r, code);
     progress();
     last_line = std::chrono::steady_clock::now();

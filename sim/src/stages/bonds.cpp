@@ -84,13 +84,6 @@ struct PlaneTurn {
 #pragma omp declare reduction(mergeStepChecks : StepChecks : mergeChecks(omp_out, omp_in)) \
     initializer(omp_priv = StepChecks{})
 
-/// What one bond does in this step.
-struct BondOutcome {
-  bool broke = false;
-  BondFailureMode mode = BondFailureMode::Tensile;
-  BondStress stress;
-};
-
 }  // namespace
 
 void World::Impl::bondStage(StepChecks& checks) {
