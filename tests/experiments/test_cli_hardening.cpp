@@ -190,7 +190,7 @@ TEST_CASE("an earlier run in --out is refused without --overwrite and cleared wi
   fs::remove_all(out);
 }
 
-TEST_CASE("--skip-complete leaves a completed run as it is, before its scene is even read", "[cli]") {
+TEST_CASE("a completed run is skipped by --skip-complete before its scene is even read", "[cli]") {
   const fs::path out = tempDir("skip");
   REQUIRE(run(with({"run", kHopper, "--out", out.string()}, kShort)).code == 0);
   const std::string before = listing(out);

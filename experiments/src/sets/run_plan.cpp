@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include <sstream>
 #include <cerrno>
 #include <csignal>
+#include <string_view>
 #include <thread>
 
 #include "common/atomic_file.h"
@@ -34,6 +36,11 @@ namespace {
 
 /// Quoted for POSIX sh: 'it'\''s'.
 std::string shellQuote(const std::string& s) {
+  // A word of these characters means the same to the shell bare: the line stays readable.
+  const bool plain = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_-./=:,+@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return s;
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
