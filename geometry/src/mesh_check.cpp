@@ -13,6 +13,7 @@
 #include <assimp/scene.h>
 
 #include "assimp_mesh.h"
+#include "hole_fill.h"
 #include "rocklab/geometry/mesh_file_check.h"
 
 namespace rocklab::geometry {
@@ -112,7 +113,8 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
   return weldIdenticalVertices(soup);
 }
 
-TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& name, MeshCheckReport& report) {
+TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& name, MeshCheckReport& report,
+                                std::size_t fill_holes_up_to) {
   const std::string where = "mesh '" + name + "': ";
   report = MeshCheckReport{};
   report.input_triangles = mesh.triangles.size();
@@ -142,6 +144,17 @@ TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& nam
   if (report.zero_area)
     report.warnings.push_back(std::to_string(report.zero_area) +
                               " degenerate triangles of zero area (collinear corners) kept; they add no volume");
+
+  // 1b. Small holes closed, when asked: a scan that misses a few triangles.
+  if (fill_holes_up_to > 0) {
+    const detail::HoleFill fill = detail::fillSmallHoles(mesh.vertices, tris, fill_holes_up_to);
+    report.holes_filled = fill.holes_filled;
+    report.hole_triangles_added = fill.triangles_added;
+    if (fill.holes_filled)
+      report.warnings.push_back(std::to_string(fill.holes_filled) + " holes of at most " +
+                                std::to_string(fill.largest_filled) + " edges closed by " +
+                                std::to_string(fill.triangles_added) + " patch triangles");
+  }
 
   // 2. Edge topology: closed = every edge used exactly twice.
   const std::vector<EdgeUse> uses = edgeUses(tris);
@@ -174,6 +187,10 @@ TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& nam
           << edgeList(mesh.vertices, nonmanifold_edges, report.nonmanifold_edges);
     msg << ". A clump needs one closed, manifold surface: repair the scan (e.g. close holes, "
            "remove duplicate faces) and try again";
+    if (report.boundary_edges)
+      msg << (fill_holes_up_to > 0 ? " (--fill-holes " + std::to_string(fill_holes_up_to) +
+                                         " closed what it could: the rest are larger holes or touch each other)"
+                                   : " (--fill-holes N closes holes of up to N edges)");
     throw MeshCheckError(msg.str());
   }
 

@@ -304,3 +304,41 @@ TEST_CASE("a volume tolerance stops the greedy selection when it is met", "[mesh
     }
   }
 }
+
+TEST_CASE("small holes of a scan are closed when asked: the patch restores the volume and faces out", "[mesh]") {
+  const TriangleMesh sphere = icosphere(3, 0.02);  // 1280 triangles, closed
+  const double volume = meshMassProperties(sphere).volume;
+  MeshCheckReport report;
+
+  SECTION("one missing triangle: refused as it is, closed by the same triangle with --fill-holes 3") {
+    TriangleMesh open = sphere;
+    open.triangles.erase(open.triangles.begin() + 100);
+    CHECK_THROWS_WITH(checkAndRepairMesh(open, "scan", report),
+                      Catch::Contains("3 open boundary edges") && Catch::Contains("--fill-holes N"));
+    const TriangleMesh closed = checkAndRepairMesh(open, "scan", report, 3);
+    CHECK(report.holes_filled == 1);
+    CHECK(report.hole_triangles_added == 1);
+    CHECK(report.flipped_inconsistent == 0);  // the patch runs the way the surface does
+    CHECK_FALSE(report.flipped_inward);
+    CHECK(closed.triangles.size() == sphere.triangles.size());
+    CHECK(meshMassProperties(closed).volume == Approx(volume).epsilon(1e-12));
+  }
+  SECTION("the fan around a vertex gone (a six-edge hole): closed flat, only with a limit of six or more") {
+    TriangleMesh open = sphere;
+    const std::uint32_t apex = open.triangles[0][0];
+    std::erase_if(open.triangles, [apex](const auto& t) { return t[0] == apex || t[1] == apex || t[2] == apex; });
+    const std::size_t removed = sphere.triangles.size() - open.triangles.size();
+    REQUIRE((removed == 5 || removed == 6));  // icosahedron corners have five neighbours, the rest six
+    CHECK_THROWS_WITH(checkAndRepairMesh(open, "scan", report, removed - 1),
+                      Catch::Contains("closed what it could"));
+    const TriangleMesh closed = checkAndRepairMesh(open, "scan", report, removed);
+    CHECK(report.holes_filled == 1);
+    CHECK(report.hole_triangles_added == removed - 2);  // a polygon of n corners: n - 2 triangles
+    CHECK(report.flipped_inconsistent == 0);
+    CHECK_FALSE(report.flipped_inward);
+    // The flat patch cuts off the cap the fan made: a little less volume, never more.
+    const double patched = meshMassProperties(closed).volume;
+    CHECK(patched < volume);
+    CHECK(patched > 0.999 * volume);
+  }
+}

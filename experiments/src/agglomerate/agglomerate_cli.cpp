@@ -41,6 +41,9 @@ void addAgglomerateCommand(CLI::App& app, AgglomerateOptions& o, bool& no_previe
       ->capture_default_str();
   c->add_option("--size-kind", o.size_kind, "equivalent (equal-volume sphere diameter) | sieve")
       ->capture_default_str();
+  c->add_option("--fill-holes", o.fill_holes,
+                "Mesh method: close holes of the scan whose rim has at most N edges by a minimum-area patch (0 = none)")
+      ->check(CLI::Range(0, 100000));
   c->add_option("--unit", o.unit, "Unit of the mesh file's coordinates: m | mm")
       ->capture_default_str();
   c->add_option("--count", o.count, "Agglomerates to make, seeds --seed, --seed+1, ...")

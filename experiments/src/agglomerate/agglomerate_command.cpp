@@ -184,7 +184,9 @@ int runUnguarded(const AgglomerateOptions& o, std::ostream& log) {
           prepareMeshSource(o.mesh, o.unit == "mm" ? 1e-3 : 1.0, o.size,
                             o.size_kind == "sieve" ? geometry::MeshSizeMeasure::SieveSize
                                                    : geometry::MeshSizeMeasure::EquivalentDiameter,
-                            o.r_max, o.gap_tolerance);
+                            o.r_max, o.gap_tolerance, static_cast<std::size_t>(o.fill_holes));
+    if (mesh)
+      for (const std::string& w : mesh->repairs) log << "warning: mesh '" << o.mesh << "': " << w << "\n";
   } catch (const BadInput& e) {
     log << "error: " << e.what() << "\n";
     return kExitBadInput;

@@ -19,6 +19,7 @@ struct AgglomerateOptions {
   double size = 0.0;                     // m  mesh size (0 = as in the file)
   std::string size_kind = "equivalent";  // equivalent | sieve
   std::string unit = "m";                // unit of the mesh file: m | mm
+  int fill_holes = 0;                    // mesh method: close holes of up to this many edges (0 = none)
   int count = 1;                         // agglomerates
   std::uint64_t seed = 1;
   double gap_tolerance = 1e-3;  // -  bond gap, of the smaller radius

@@ -75,12 +75,14 @@ const char* methodName(Method method) {
 
 MeshSource prepareMeshSource(const std::string& file, double metres_per_unit, double size,
                              geometry::MeshSizeMeasure measure, double r_max,
-                             double gap_tolerance) {
+                             double gap_tolerance, std::size_t fill_holes) {
   MeshSource m;
   m.file = file;
-  m.mesh = geometry::readMeshFile(file, metres_per_unit);
   geometry::MeshCheckReport report;
-  const geometry::TriangleMesh checked = geometry::checkAndRepairMesh(m.mesh, file, report);
+  // Checked (and repaired) once: each agglomerate's carve then checks a closed mesh.
+  m.mesh = geometry::checkAndRepairMesh(geometry::readMeshFile(file, metres_per_unit), file, report, fill_holes);
+  m.repairs = report.warnings;
+  const geometry::TriangleMesh& checked = m.mesh;
   const geometry::MeshMassProperties props = geometry::meshMassProperties(checked);
   const geometry::ShapeDescriptors shape = geometry::shapeDescriptors(checked, props);
   const double current = measure == geometry::MeshSizeMeasure::SieveSize

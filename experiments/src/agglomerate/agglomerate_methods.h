@@ -33,8 +33,9 @@ const char* methodName(Method method);
 /// The particle surface of the mesh method, read and checked once for all agglomerates.
 struct MeshSource {
   std::string file;
-  geometry::TriangleMesh mesh;   // m, as read (unit applied)
+  geometry::TriangleMesh mesh;   // m, as read (unit applied), checked and repaired
   geometry::CarveOptions carve;  // size, measure, name
+  std::vector<std::string> repairs;  // what the check repaired (one sentence each)
   double dense_diameter = 0.0;   // m  of the dense agglomerate it is carved from
 };
 
@@ -42,9 +43,11 @@ struct MeshSource {
 /// (m, by `measure`; 0 = as read) and finds the diameter of the dense agglomerate:
 /// twice the mesh's reach from its centroid plus 2 r_max (carving puts the mesh's
 /// centroid on the spheres', which is near but not at the centre). Throws
-/// geometry::MeshCheckError for an unreadable, open or non-manifold mesh.
+/// geometry::MeshCheckError for an unreadable, open or non-manifold mesh; holes of
+/// at most `fill_holes` edges are closed first (0: none).
 MeshSource prepareMeshSource(const std::string& file, double metres_per_unit, double size,
-                             geometry::MeshSizeMeasure measure, double r_max, double gap_tolerance);
+                             geometry::MeshSizeMeasure measure, double r_max, double gap_tolerance,
+                             std::size_t fill_holes = 0);
 
 struct AgglomerateSpec {
   Method method = Method::Dense;

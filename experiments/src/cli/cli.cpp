@@ -330,6 +330,9 @@ void addCommands(CLI::App& app, CliArgs& a) {
   shape->add_option("--spheres", a.shape_options.spheres, "Largest number of spheres");
   shape->add_option("--tolerance", a.shape_options.tolerance, "Stop when the uncovered volume fraction is below this (0 = off)");
   shape->add_option("--unit", a.shape_options.unit, "Unit of the file's coordinates: m | mm");
+  shape->add_option("--fill-holes", a.shape_options.fill_holes,
+                    "Close holes of the scan whose rim has at most N edges by a minimum-area patch (0 = none: an open mesh is an error)")
+      ->check(CLI::Range(0, 100000));
   shape->add_option("--size", a.shape_options.size, "Scale to this size (m); see --size-kind");
   shape->add_option("--size-kind", a.shape_options.size_kind, "equivalent (equal-volume sphere diameter) | sieve");
   shape->add_option("--density", a.shape_options.density, "kg/m^3 (mass and inertia in clump.toml)");

@@ -102,7 +102,8 @@ Prepared prepare(const ShapeOptions& o, std::ostream& log) {
   const double unit = o.unit == "mm" ? 1e-3 : 1.0;
   geometry::TriangleMesh raw;
   try {
-    raw = geometry::checkAndRepairMesh(geometry::readMeshFile(o.mesh, unit), o.mesh, p.check);
+    raw = geometry::checkAndRepairMesh(geometry::readMeshFile(o.mesh, unit), o.mesh, p.check,
+                                       static_cast<std::size_t>(o.fill_holes));
   } catch (const geometry::MeshCheckError& e) {
     throw BadInput(e.what());
   }
@@ -499,6 +500,8 @@ json meshJson(const ShapeOptions& o, const Prepared& p) {
 json checksJson(const geometry::MeshCheckReport& c) {
   return {{"warnings", c.warnings},
           {"degenerate_removed", c.collapsed_removed},
+          {"holes_filled", c.holes_filled},
+          {"hole_triangles_added", c.hole_triangles_added},
           {"zero_area_triangles", c.zero_area},
           {"flipped_inconsistent", c.flipped_inconsistent},
           {"flipped_inward", c.flipped_inward},

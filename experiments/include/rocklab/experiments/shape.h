@@ -16,6 +16,7 @@ struct ShapeOptions {
   int spheres = 20;                  // largest sphere count
   double tolerance = 0.0;            // stop early when the uncovered volume fraction is <= this (0 = off)
   std::string unit = "m";            // unit of the file's coordinates: "m" | "mm"
+  int fill_holes = 0;                // close holes of up to this many edges (0 = none: an open mesh is an error)
   double size = 0.0;                 // m, target size (0 = as in the file)
   std::string size_kind = "equivalent";  // "equivalent" (diameter of the equal-volume sphere) | "sieve"
   double density = 2730.0;           // kg/m^3 (the study's pebbles)

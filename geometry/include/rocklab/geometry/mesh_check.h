@@ -13,6 +13,8 @@
 // Policy (a scan is rarely perfect; a clump needs a closed surface):
 //   errors (MeshCheckError, nothing written): file missing/unreadable, no triangles,
 //     open boundary edges, non-manifold edges, a shell that cannot be oriented;
+//   repaired only when asked (`fill_holes_up_to` > 0): holes whose boundary is a
+//     simple loop of at most that many edges, closed by a minimum-area patch (CGAL);
 //   repaired with a warning: collapsed triangles (a repeated vertex) removed,
 //     inconsistent orientation fixed (each shell to its majority, flipped count
 //     reported), inward normals (negative volume) flipped, several shells (the
@@ -37,7 +39,9 @@ struct MeshCheckReport {
   std::size_t vertices = 0;             // after welding
   std::size_t collapsed_removed = 0;    // triangles with a repeated vertex, removed
   std::size_t zero_area = 0;            // zero-area triangles (kept)
-  std::size_t boundary_edges = 0;       // edges used by one triangle
+  std::size_t holes_filled = 0;         // boundary loops closed by a patch (when asked)
+  std::size_t hole_triangles_added = 0; // the patches' triangles
+  std::size_t boundary_edges = 0;       // edges used by one triangle (after any patch)
   std::size_t nonmanifold_edges = 0;    // edges used by more than two triangles
   std::size_t flipped_inconsistent = 0; // triangles flipped to agree with their shell
   bool flipped_inward = false;          // the kept shell was inside out and was flipped
@@ -52,9 +56,11 @@ struct MeshCheckReport {
 TriangleMesh readMeshFile(const std::string& path, double scale);
 
 /// Checks and repairs a welded mesh (see the policy above). `name` goes into every
-/// message (usually the file path). Throws MeshCheckError for the error classes;
+/// message (usually the file path). Holes of at most `fill_holes_up_to` boundary
+/// edges are closed first (0: none). Throws MeshCheckError for the error classes;
 /// returns the repaired single closed, outward-oriented shell.
-TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& name, MeshCheckReport& report);
+TriangleMesh checkAndRepairMesh(const TriangleMesh& mesh, const std::string& name, MeshCheckReport& report,
+                                std::size_t fill_holes_up_to = 0);
 
 /// Welds vertices with identical coordinates and renumbers triangles.
 TriangleMesh weldIdenticalVertices(const TriangleMesh& mesh);
