@@ -148,7 +148,7 @@ TEST_CASE("a failed run's page says why, and figures it lacks are shown as absen
   rocklab::experiments::detail::writeRunReport(out, r);
   const std::string page = slurp(out / "report.html");
   CHECK_THAT(page, Contains("<span class=\"status bad\">watchdog</span>"));
-  CHECK_THAT(page, Contains("This run watchdog:</strong> energy grew by 12 J &lt;beyond&gt; the work of the walls"));
+  CHECK_THAT(page, Contains("Run watchdog:</strong> energy grew by 12 J &lt;beyond&gt; the work of the walls"));
   CHECK_THAT(page, Contains("above 1: unstable"));
   CHECK(xmllint(out / "report.html", false).empty());
   fs::remove_all(out);

@@ -162,10 +162,10 @@ std::string htmlTable(const std::vector<std::string>& header, const std::vector<
 
 std::string htmlFigure(const fs::path& dir, const fs::path& png, const std::string& caption) {
   std::string others;
-  for (const char* ext : {".svg", ".pdf", ".csv"}) {
+  for (const auto& [ext, what] : {std::pair{".svg", "SVG"}, std::pair{".pdf", "PDF"}, std::pair{".plot.csv", "data"}}) {
     fs::path other = png;
     other.replace_extension(ext);
-    if (fs::exists(dir / other)) others += " " + link(other, std::string(ext + 1));
+    if (fs::exists(dir / other)) others += " " + link(other, what);
   }
   return "<figure><a href=\"" + hrefOf(png) + "\"><img src=\"" + hrefOf(png) + "\" alt=\"" + htmlText(caption) +
          "\" /></a><figcaption>" + htmlText(caption) + (others.empty() ? "" : " —" + others) +

@@ -23,7 +23,7 @@ std::string shortNumber(double v);
 /// A table; cells are HTML already (escape text with htmlText).
 std::string htmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
 /// A figure: the image, its caption, and links to the files of the same stem
-/// beside it that hold the plot otherwise (.svg, .pdf, .csv).
+/// beside it that hold the plot otherwise (.svg, .pdf, and its data .plot.csv: plot.h).
 std::string htmlFigure(const std::filesystem::path& dir, const std::filesystem::path& png, const std::string& caption);
 /// Every file under `dir` (recursively), each linked with its size; a subfolder
 /// folded (<details>) under its name and file count.

@@ -68,6 +68,7 @@ std::vector<Headline> headlinesOf(const std::string& experiment) {
 
 /// A results.json value as a cell: numbers with 4 digits, text escaped, absent as "—".
 std::string valueCell(const json& v) {
+  if (v.is_number_integer()) return v.dump();
   if (v.is_number()) return shortNumber(v.get<double>());
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
   if (v.is_string()) return htmlText(v.get<std::string>());
@@ -88,8 +89,9 @@ std::string statusLine(const json& r) {
   s += "</p>\n";
   if (!ok) {
     const std::string why = r.contains("message") && r["message"].is_string() ? r["message"].get<std::string>()
-                                                                               : "results.json gives no reason";
-    s += "<div class=\"failure\"><strong>This run " + htmlText(status) + ":</strong> " + htmlText(why) +
+                            : status == "interrupted" ? "stopped by Ctrl-C, SIGTERM or SIGHUP; the outputs so far are kept"
+                                                      : "results.json gives no reason";
+    s += "<div class=\"failure\"><strong>Run " + htmlText(status) + ":</strong> " + htmlText(why) +
          ". The figures below are those of the state it reached.</div>\n";
   }
   for (const json& w : r.value("warnings", json::array()))

@@ -129,7 +129,8 @@ std::string setReportHtml(const fs::path& dir) {
   if (folder.filename().empty()) folder = folder.parent_path();  // "out/sweep/" ends in a separator
   const std::string title = "rocklab " + setKind(dir) + ": " + folder.filename().string();
   std::string tables, figures;
-  for (const fs::path& csv : filesWith(dir, ".csv")) tables += csvTable(dir, csv);
+  for (const fs::path& csv : filesWith(dir, ".csv"))
+    if (csv.stem().extension() != ".plot") tables += csvTable(dir, csv);  // a plot's data is linked under it
   for (const fs::path& png : filesWith(dir, ".png")) figures += htmlFigure(dir, png, png.stem().string());
   std::string body = "<h1>" + htmlText(title) + "</h1>\n" + conclusions(dir);
   if (!tables.empty()) body += htmlSection("Tables", tables);
