@@ -148,6 +148,15 @@ std::string shortNumber(double v) {
   return buf;
 }
 
+std::vector<fs::path> filesWithExtension(const fs::path& dir, const std::string& extension) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file(ec) && it->path().extension() == extension) files.push_back(it->path().filename());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 std::string htmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows) {
   std::string t = "<table>\n<tr>";
   for (const std::string& h : header) t += "<th>" + h + "</th>";

@@ -20,6 +20,9 @@ std::string link(const std::filesystem::path& relative, const std::string& text)
 /// A number as a page shows it: 4 significant digits, or "—" when not finite.
 std::string shortNumber(double v);
 
+/// The regular files of `dir` (not its subfolders) whose names end in `extension`, by name.
+std::vector<std::filesystem::path> filesWithExtension(const std::filesystem::path& dir, const std::string& extension);
+
 /// A table; cells are HTML already (escape text with htmlText).
 std::string htmlTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
 /// A figure: the image, its caption, and links to the files of the same stem

@@ -161,18 +161,9 @@ std::string markerTable(const json& r) {
 
 bool isStill(const fs::path& name) { return name.filename().string().find("_still_") != std::string::npos; }
 
-std::vector<fs::path> topLevelFiles(const fs::path& dir, const std::string& extension) {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    if (it->is_regular_file(ec) && it->path().extension() == extension) files.push_back(it->path().filename());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 std::string plots(const fs::path& dir) {
   std::string s;
-  for (const fs::path& png : topLevelFiles(dir, ".png"))
+  for (const fs::path& png : filesWithExtension(dir, ".png"))
     if (!isStill(png)) s += htmlFigure(dir, png, png.stem().string());
   return s.empty() ? "" : htmlSection("Plots", s);
 }
@@ -182,7 +173,7 @@ std::string plots(const fs::path& dir) {
 std::string movies(const fs::path& dir, const json& r) {
   if (!r.contains("cameras") || !r["cameras"].is_array()) return "";
   std::string s;
-  const std::vector<fs::path> stills = topLevelFiles(dir, ".png");
+  const std::vector<fs::path> stills = filesWithExtension(dir, ".png");
   for (const json& c : r["cameras"]) {
     if (!c.is_object() || !c.contains("name") || !c["name"].is_string()) continue;
     const std::string name = c["name"].get<std::string>();

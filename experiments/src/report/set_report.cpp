@@ -20,15 +20,6 @@ namespace {
 
 constexpr std::size_t kMaxTableRows = 1000;  // a longer table is cut on the page (the CSV is linked)
 
-std::vector<fs::path> filesWith(const fs::path& dir, const std::string& extension) {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    if (it->is_regular_file(ec) && it->path().extension() == extension) files.push_back(it->path().filename());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 std::vector<std::string> splitCsvLine(const std::string& line) {
   std::vector<std::string> cells;
   std::stringstream in(line);
@@ -129,9 +120,9 @@ std::string setReportHtml(const fs::path& dir) {
   if (folder.filename().empty()) folder = folder.parent_path();  // "out/sweep/" ends in a separator
   const std::string title = "rocklab " + setKind(dir) + ": " + folder.filename().string();
   std::string tables, figures;
-  for (const fs::path& csv : filesWith(dir, ".csv"))
+  for (const fs::path& csv : filesWithExtension(dir, ".csv"))
     if (csv.stem().extension() != ".plot") tables += csvTable(dir, csv);  // a plot's data is linked under it
-  for (const fs::path& png : filesWith(dir, ".png")) figures += htmlFigure(dir, png, png.stem().string());
+  for (const fs::path& png : filesWithExtension(dir, ".png")) figures += htmlFigure(dir, png, png.stem().string());
   std::string body = "<h1>" + htmlText(title) + "</h1>\n" + conclusions(dir);
   if (!tables.empty()) body += htmlSection("Tables", tables);
   if (!figures.empty()) body += htmlSection("Plots", figures);
