@@ -124,7 +124,7 @@ std::string slurpText(const fs::path& p) {
 }
 }  // namespace
 
-TEST_CASE("gnuplot draws PNG and SVG with the data beside them; log axes skip points <= 0", "[plot]") {
+TEST_CASE("gnuplot draws PNG and SVG with the data beside them - log axes skip points <= 0", "[plot]") {
   if (rocklab::experiments::detail::gnuplotProgram().empty())
     FAIL("gnuplot is not installed (scripts/setup.sh installs gnuplot-nox)");
   const fs::path dir = tempDir("gnuplot");
@@ -154,7 +154,7 @@ TEST_CASE("gnuplot draws PNG and SVG with the data beside them; log axes skip po
   CHECK_THROWS_WITH(writePlot(spec, dir / "bad.png"), Contains("lo > 0"));
 }
 
-TEST_CASE("without gnuplot the built-in plotter draws the PNG (no SVG); a failing gnuplot names the plot", "[plot]") {
+TEST_CASE("without gnuplot the built-in plotter draws the PNG (no SVG) - a failing gnuplot names the plot", "[plot]") {
   const fs::path dir = tempDir("fallback");
   PlotSpec spec;
   spec.series = {{"s", {1, 10, 100}, {1, 2, 3}}};

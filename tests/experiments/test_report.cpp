@@ -70,7 +70,7 @@ std::vector<std::string> unlinkedFiles(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("a run writes report.html: well-formed, every file linked, the movie and stills shown; report rebuilds it",
+TEST_CASE("a run writes report.html: well-formed, every file linked, the movie and stills shown - report rebuilds it",
           "[report]") {
   const fs::path out = scratchDir("report-run");
   fs::create_directories(out);
@@ -174,4 +174,83 @@ TEST_CASE("a sweep writes one page: its table and plot, linking each run's page"
   CHECK(run_pages == 2);
   CHECK(unlinkedFiles(out).empty());
   fs::remove_all(out);
+}
+
+namespace {
+
+/// What headless Chromium saw on `page` (in its folder, so relative links resolve):
+/// "images L/N videos R/M", L images loaded of N, R videos whose MP4 gave its
+/// metadata and size of M. A copy of the page with a probe script is opened and removed.
+std::string chromiumProbe(const fs::path& page) {
+  const fs::path probe_page = page.parent_path() / "report-probe.html", dom = page.parent_path() / "probe-dom.txt";
+  std::string html = slurp(page);
+  const std::string probe = R"(<script>
+window.addEventListener('load', () => setTimeout(() => {
+  const imgs = Array.from(document.images), vids = Array.from(document.querySelectorAll('video'));
+  const p = document.createElement('pre');
+  p.id = 'rocklab-probe';
+  p.textContent = 'images ' + imgs.filter(i => i.complete && i.naturalWidth > 0).length + '/' + imgs.length +
+      ' videos ' + vids.filter(v => v.readyState >= 1 && !v.error && v.videoWidth > 0).length + '/' + vids.length;
+  document.body.appendChild(p);
+}, 3000));
+</script>
+</body>)";
+  html.replace(html.rfind("</body>"), 7, probe);
+  std::ofstream(probe_page) << html;
+  const std::string command = "timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=10000 "
+                              "--dump-dom 'file://" + fs::absolute(probe_page).string() + "' > '" + dom.string() +
+                              "' 2>/dev/null";
+  std::system(command.c_str());
+  const std::string text = slurp(dom);
+  fs::remove(probe_page);
+  fs::remove(dom);
+  std::smatch m;
+  return std::regex_search(text, m, std::regex(R"(id="rocklab-probe">([^<]*))")) ? m[1].str() : "no probe result";
+}
+
+}  // namespace
+
+// Not in CI (label validation): needs Debian's chromium. Opens the demo's page when
+// out/demo has one (bash scripts/demo.sh), else a short filmed run's, and saves a screenshot.
+TEST_CASE("the page in headless Chromium: the video and every image load - a screenshot", "[report][validation]") {
+  REQUIRE(std::system("command -v chromium > /dev/null") == 0);  // apt-get install chromium
+  fs::path dir = fs::path(ROCKLAB_SOURCE_DIR) / "out" / "demo";
+  const fs::path out = scratchDir("report-chromium");
+  if (!fs::exists(dir / "report.html")) {
+    fs::create_directories(out);
+    std::ofstream(out / "filmed.toml") << "extends = \"" << kHopper << "\"\n[scene]\nname = \"filmed\"\nend_time = 0.004\n"
+                                       << "[[cameras]]\nname = \"top\"\nresolution = [320, 240]\nfov_deg = 60.0\n"
+                                          "frame_rate = 1000\neye = [0.0, 0.0, 1.5]\ntarget = [0.0, 0.0, 0.3]\n"
+                                          "up = [1.0, 0.0, 0.0]\nmovie = true\nstill_interval = 0.002\n";
+    dir = out / "run";
+    REQUIRE(cli({"run", (out / "filmed.toml").string(), "--out", dir.string(), "--quiet", "--set",
+                 "particles.0.count=200"}) == 0);
+  }
+  const std::string page = slurp(dir / "report.html");
+  std::size_t images = 0, videos = 0;
+  for (std::size_t at = page.find("<img "); at != std::string::npos; at = page.find("<img ", at + 1)) ++images;
+  for (std::size_t at = page.find("<video "); at != std::string::npos; at = page.find("<video ", at + 1)) ++videos;
+  REQUIRE(images > 0);
+  REQUIRE(videos > 0);
+  const std::string all = std::to_string(images) + "/" + std::to_string(images);
+  CHECK(chromiumProbe(dir / "report.html") ==
+        "images " + all + " videos " + std::to_string(videos) + "/" + std::to_string(videos));
+
+  // The probe sees a broken image: the same page with one image pointing nowhere.
+  const fs::path broken = dir / "report-broken.html";
+  std::string changed = page;
+  changed.replace(changed.find("<img src=\"") + 10, 0, "missing-");
+  std::ofstream(broken) << changed;
+  CHECK(chromiumProbe(broken).rfind("images " + std::to_string(images - 1) + "/" + std::to_string(images), 0) == 0);
+  fs::remove(broken);
+
+  const fs::path shot = out / "report-screenshot.png";
+  fs::create_directories(out);
+  const std::string command = "timeout 120 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
+                              "--window-size=1280,1800 --virtual-time-budget=5000 --screenshot='" + shot.string() +
+                              "' 'file://" + fs::absolute(dir / "report.html").string() + "' > /dev/null 2>&1";
+  std::system(command.c_str());
+  CHECK(fs::exists(shot));
+  CHECK((fs::exists(shot) && fs::file_size(shot) > 10000));
+  WARN("screenshot: " + shot.string());
 }

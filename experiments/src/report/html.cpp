@@ -84,7 +84,8 @@ td.num { text-align: right; font-variant-numeric: tabular-nums; }
 .failure { border: 2px solid #c62828; background: #fdecea; padding: 0.6rem 1rem; margin: 1rem 0; }
 .warning { border: 1px solid #ef6c00; background: #fff3e0; padding: 0.4rem 1rem; margin: 0.5rem 0; }
 figure { display: inline-block; margin: 0.5rem 1rem 1rem 0; vertical-align: top; }
-figure img, video { max-width: 100%; border: 1px solid #ddd; }
+figure img { max-width: min(100%, 36rem); border: 1px solid #ddd; }  /* full size one click away */
+video { max-width: 100%; border: 1px solid #ddd; }
 figcaption { font-size: 0.9rem; color: #555; }
 .bar { display: inline-block; height: 0.7rem; background: #0072b2; }
 .size { color: #777; font-size: 0.85rem; }
