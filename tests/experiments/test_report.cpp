@@ -89,6 +89,8 @@ TEST_CASE("a run writes report.html: well-formed, every file linked, the movie a
   CHECK(unlinkedFiles(run).empty());
   CHECK_THAT(page, Contains("<span class=\"status\">completed</span>"));
   CHECK_THAT(page, Contains("<h1>rocklab run: filmed</h1>"));
+  CHECK_THAT(page, Contains("<td>scene file</td><td>" + scene.string() + "</td>"));  // results.json settings
+  CHECK_THAT(page, Contains("<td>end time (s)</td><td>0.004</td>"));
   if (fs::exists(run / "top.mp4")) CHECK_THAT(page, Contains("<source src=\"top.mp4\" type=\"video/mp4\" />"));
   CHECK_THAT(page, Contains("<img src=\"top_still_"));
   CHECK_THAT(page, Contains("Time-step audit"));
