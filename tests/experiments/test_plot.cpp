@@ -1,6 +1,12 @@
-// PNG plots: drawn at the asked size with the series colours, written atomically,
+// Plots: drawn at the asked size with the series colours (gnuplot, or the built-in
+// plotter without it), SVG and data beside the PNG, log axes, written atomically,
 // errors name the file, degenerate data does not crash.
+#include <sys/wait.h>
+
 #include <catch2/catch.hpp>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -8,9 +14,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "analysis/plot.h"
+#include "analysis/plot_internal.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
+using Catch::StartsWith;
 namespace fs = std::filesystem;
 
 namespace {
@@ -96,4 +104,70 @@ TEST_CASE("degenerate data: constant - single point - no finite data", "[plot]")
   CHECK_NOTHROW(writePlot(spec, dir / "clipped.png"));
   for (const char* name : {"constant.png", "point.png", "nothing.png", "clipped.png"})
     CHECK(cv::imread((dir / name).string()).cols == 900);
+}
+
+namespace {
+/// Runs `command` through the shell; its exit code.
+int shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+/// Sets an environment variable for one scope.
+struct ScopedEnv {
+  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
+  ~ScopedEnv() { ::unsetenv(name_); }
+  const char* name_;
+};
+std::string slurpText(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+}  // namespace
+
+TEST_CASE("gnuplot draws PNG and SVG with the data beside them - log axes skip points <= 0", "[plot]") {
+  if (rocklab::experiments::detail::gnuplotProgram().empty())
+    FAIL("gnuplot is not installed (scripts/setup.sh installs gnuplot-nox)");
+  const fs::path dir = tempDir("gnuplot");
+  PlotSpec spec;
+  spec.title = "passing \"fraction\" & size <log-log>";
+  spec.x_label = "size (m)";
+  spec.y_label = "passing (%)";
+  spec.log_x = spec.log_y = true;
+  spec.series = {{"product, run 1", {0.001, 0.01, 0.1, 0.0, 1.0}, {0.01, 0.1, 10.0, 5.0, 100.0}},
+                 {"lab", {0.002, 0.02}, {-1.0, 1.0}, PlotSeries::Style::Points}};
+  writePlot(spec, dir / "curve.png");
+  const cv::Mat img = cv::imread((dir / "curve.png").string(), cv::IMREAD_COLOR);
+  REQUIRE(!img.empty());
+  CHECK(img.cols == 900);
+  CHECK(countColour(img, {178, 114, 0}) > 100);  // palette colour 0 (#0072B2), as the built-in plotter's
+  const std::string svg = slurpText(dir / "curve.svg");
+  CHECK_THAT(svg, Contains("<svg"));
+  CHECK(shell("xmllint --noout '" + (dir / "curve.svg").string() + "'") == 0);  // well-formed, title escaped
+  CHECK_THAT(svg, Contains("> 0.01<") && Contains("> 0.001<"));  // decade ticks of the log axes
+  CHECK_THAT(svg, Contains("passing \"fraction\" &amp; size &lt;log-log>"));  // the title as given
+  const std::string csv = slurpText(dir / "curve.plot.csv");
+  CHECK_THAT(csv, StartsWith("series,size (m),passing (%)\n"));
+  CHECK_THAT(csv, Contains("\"product, run 1\",0.001,0.01\n") && Contains("lab,0.002,-1\n"));
+  for (const char* left : {"curve.png.partial", "curve.svg.partial", "curve.plot.csv.partial"})
+    CHECK_FALSE(fs::exists(dir / left));
+  spec.y_range = std::pair{0.0, 10.0};  // a log axis cannot start at 0
+  CHECK_THROWS_WITH(writePlot(spec, dir / "bad.png"), Contains("lo > 0"));
+}
+
+TEST_CASE("without gnuplot the built-in plotter draws the PNG (no SVG) - a failing gnuplot names the plot", "[plot]") {
+  const fs::path dir = tempDir("fallback");
+  PlotSpec spec;
+  spec.series = {{"s", {1, 10, 100}, {1, 2, 3}}};
+  spec.log_x = true;
+  {
+    const ScopedEnv none("ROCKLAB_GNUPLOT", "none");
+    writePlot(spec, dir / "p.png");
+  }
+  CHECK(cv::imread((dir / "p.png").string()).cols == 900);
+  CHECK_FALSE(fs::exists(dir / "p.svg"));
+  CHECK(fs::exists(dir / "p.plot.csv"));
+  const ScopedEnv failing("ROCKLAB_GNUPLOT", "false");  // exits 1 at once
+  CHECK_THROWS_WITH(writePlot(spec, dir / "q.png"), Contains((dir / "q.png").string()) && Contains("gnuplot (false) failed"));
+  CHECK_FALSE(fs::exists(dir / "q.png"));
+  CHECK_FALSE(fs::exists(dir / "q.png.partial"));
 }

@@ -1,6 +1,8 @@
 #pragma once
-// PNG line/point plots drawn with OpenCV (core, imgproc, imgcodecs): the figures
-// an experiment writes next to its results.json (angle vs friction, profiles, ...).
+// Line/point plots: the figures an experiment, sweep or study writes next to its
+// results (angle vs friction, profiles, force-displacement, Weibull, ...). Drawn by
+// gnuplot (Debian gnuplot-nox) as PNG and SVG, the plotted data as CSV beside them;
+// without gnuplot, by the built-in OpenCV plotter as PNG only (plot_internal.h).
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -21,12 +23,20 @@ struct PlotSpec {
   // Axis ranges; default: the finite data range with a 5 % margin (a single value gets a span
   // of ±10 % of its magnitude, or ±0.5 when it is 0; no finite data gives [0, 1]).
   std::optional<std::pair<double, double>> x_range, y_range;
+  // Logarithmic axes (product curves, Weibull plots): points <= 0 on them are skipped
+  // like non-finite ones; a fixed range must then be positive.
+  bool log_x = false, log_y = false;
   int width = 900, height = 600;  // pixels; at least 200 × 150
 };
 
-/// Draws the plot and writes it as PNG atomically (to "<png>.partial", then rename), so a half-written
-/// plot never replaces a good one. Throws std::runtime_error naming the file when it cannot write, and
-/// std::invalid_argument when a series has x and y of different lengths or the size is too small.
+/// Draws the plot: `png`, the SVG beside it (same stem; with gnuplot only) and the
+/// plotted data as plotDataPath(png), each written atomically ("<file>.partial", then
+/// rename), so a half-written plot never replaces a good one. Throws std::runtime_error
+/// naming the file when it cannot write or gnuplot fails, and std::invalid_argument when
+/// a series has x and y of different lengths, the size is too small or a fixed range is bad.
 void writePlot(const PlotSpec& spec, const std::filesystem::path& png);
+
+/// "<stem>.plot.csv" beside the PNG: series, x, y, one row a point, as given (non-finite too).
+std::filesystem::path plotDataPath(const std::filesystem::path& png);
 
 }  // namespace rocklab::experiments

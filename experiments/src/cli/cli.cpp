@@ -16,6 +16,7 @@
 #include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
 #include "crusher/crusher_geometry_command.h"
+#include "report/run_report.h"
 #include "camera/render_run.h"
 #include "common/json_text.h"
 #include "common/quiet_log.h"
@@ -49,6 +50,7 @@ Examples:
   rocklab study drop-timestep                    # built-in study: error of restitution against run time
   rocklab study drop-timestep --plan runs/dt     # run list + Slurm script, nothing run; then:
   parallel --jobs 2 < runs/dt/runs.txt && rocklab collect runs/dt
+  rocklab report out/demo                        # rebuild out/demo/report.html from its files
   rocklab study drop --vary timestep.safety_factor=0.8,0.4,0.2,0.1 --figure restitution --reference 0.7063
   rocklab render out/demo/run.h5 --camera top.toml --out out/demo-top    # re-render stored frames
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
@@ -290,6 +292,9 @@ void addCommands(CLI::App& app, CliArgs& a) {
                                                 "plot and recommendation (failed and missing runs listed)");
   collect->add_option("dir", a.collect_dir, "Folder of a sweep or study (holds plan.json)")->required();
 
+  auto* report = app.add_subcommand("report", "Rebuild report.html of a run folder, or of a sweep, study or calibration folder");
+  report->add_option("dir", a.collect_dir, "Folder of a run (holds results.json) or of a set (plan.json, runs/)")->required();
+
   auto* weibull = app.add_subcommand(
       "weibull", "Weibull analysis of a batch of crushing runs (a sweep folder): weibull.json and the Weibull plot");
   weibull->add_option("dir", a.collect_dir, "Folder of the batch's sweep (holds sweep.csv)")->required();
@@ -519,6 +524,7 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     return runCrusherGeometry({a.scene_arg, a.overrides, a.out_dir}, std::cout, std::cerr);
   if (app.got_subcommand("scene-keys")) return doSceneKeys(a.collect_dir);
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
+  if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);
   if (app.got_subcommand("weibull")) {
     if (a.group_by.empty()) {
       if (!a.size_column.empty()) {

@@ -36,15 +36,16 @@ std::string joined(const std::vector<std::string>& names) {
 }
 
 /// Whether `entry` is something a run writes: its marks, the cameras' frames/, and
-/// the kinds of file runs write (stills and plots, movies, tables, JSON reports,
-/// files half-written when it stopped). Anything else (a scene, a clump or mesh
+/// the kinds of file runs write (stills and plots with their SVG, movies, tables, JSON
+/// reports, report.html, files half-written when it stopped). Anything else (a scene, a clump or mesh
 /// file, a log, an agglomerate library) is the user's and stays.
 bool runOutput(const fs::path& entry) {
   const std::string name = entry.filename().string();
-  if (std::find(std::begin(kRunMarks), std::end(kRunMarks), name) != std::end(kRunMarks) || name == "frames")
+  if (std::find(std::begin(kRunMarks), std::end(kRunMarks), name) != std::end(kRunMarks) || name == "frames" ||
+      name == "report.html")
     return true;
   const std::string ext = entry.extension().string();
-  for (const char* e : {".png", ".mp4", ".avi", ".csv", ".json", ".partial", ".tmp"})
+  for (const char* e : {".png", ".svg", ".mp4", ".avi", ".csv", ".json", ".partial", ".tmp"})
     if (ext == e) return true;
   return false;
 }

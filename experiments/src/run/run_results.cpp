@@ -10,6 +10,8 @@
 
 #include "camera/wall_placement.h"
 #include "common/json_text.h"
+#include "report/build_info.h"
+#include "report/run_report.h"
 #include "run/run_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -98,6 +100,15 @@ json warningsJson(const RunRecord& record) {
   return list;
 }
 
+/// What was run, for the report: the scene's file and description, its length, the source's commit.
+json settingsJson(const Scene& scene) {
+  json s = {{"source", scene.source.string()}, {"description", scene.run.description}};
+  if (scene.run.steps > 0) s["steps"] = scene.run.steps;
+  else s["end_time_s"] = scene.run.end_time;
+  if (*sourceCommit() != '\0') s["commit"] = sourceCommit();
+  return s;
+}
+
 /// The figures of the World and the run, before the cameras and the experiment add theirs.
 json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
              const RunTimes& times) {
@@ -116,6 +127,7 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["threads"] = world.threads();
   r["modules"] = setup.modules;
   r["seed"] = scene.run.seed;
+  r["settings"] = settingsJson(scene);
   r["steps"] = world.stepCount();
   r["steps_this_run"] = world.stepCount() - record.first_step;
   r["dt_s"] = setup.dt;
@@ -190,6 +202,14 @@ int writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup,
     log << "error: " << e.what() << "\n";
     if (record.exit_code == kExitOk) record.exit_code = kExitFailed;
   }
+  // The page is made from what results.json says and the files the run left; one that
+  // cannot be written (a full disk) fails the run like any other output.
+  try {
+    writeRunReport(options.out_dir, r);
+  } catch (const std::exception& e) {
+    log << "error: report.html: " << e.what() << "\n";
+    if (record.exit_code == kExitOk) record.exit_code = kExitFailed;
+  }
 
   if (!record.message.empty()) log << "error: " << record.message << "\n";
   const sim::World& world = *setup.world;
@@ -198,7 +218,8 @@ int writeResults(const Scene& scene, const RunOptions& options, RunSetup& setup,
       << std::setprecision(2) << seconds(times.start, Clock::now()) << " s (stepping "
       << steppingSeconds(record) << " s, " << std::scientific << std::setprecision(3)
       << r["particle_steps_per_s"].get<double>() << " particle-steps/s); results in "
-      << (options.out_dir / "results.json").string() << "\n";
+      << (options.out_dir / "results.json").string() << ", report "
+      << (options.out_dir / "report.html").string() << "\n";
   return record.exit_code;
 }
 

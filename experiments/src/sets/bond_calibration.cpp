@@ -16,6 +16,7 @@
 #include "analysis/weibull_report.h"
 #include "common/atomic_file.h"
 #include "common/json_text.h"
+#include "report/set_report.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
 
@@ -251,6 +252,7 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
   if (batch.plan_only) {
     j["batch"]["planned"] = true;
     detail::writeAtomically(dir / "calibration.json", detail::jsonText(j));
+    detail::refreshSetReport(dir, log, "calibrate-bonds");
     log << "calibrate-bonds: batch planned; after it ran: rocklab collect " << batch.out_dir.string()
         << " && rocklab weibull " << batch.out_dir.string() << "\n";
     return kExitOk;
@@ -272,6 +274,8 @@ int runBondCalibration(const BondCalibrationOptions& c, std::ostream& log) {
     log << ", R^2 " << w["weibull_r2"].get<double>() << "\n";
   }
   detail::writeAtomically(dir / "calibration.json", detail::jsonText(j));
+  detail::refreshSetReport(batch.out_dir, log, "calibrate-bonds");  // with the Weibull fit now
+  detail::refreshSetReport(dir, log, "calibrate-bonds");
   log << "calibrate-bonds: " << (dir / "calibration.json").string() << "\n";
   if (batch_code != kExitOk) return batch_code;
   return fit_code;

@@ -15,6 +15,7 @@
 #include "sets/run_plan.h"
 #include "sets/run_set.h"
 #include "sets/study_report.h"
+#include "report/set_report.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "scene/toml_reader.h"
@@ -300,7 +301,9 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
   } catch (const std::exception& e) {
     log << "study: no plot (" << e.what() << ")\n";
   }
-  log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << "\n";
+  refreshSetReport(dir, log, "study");
+  log << "study: table " << (dir / "study.csv").string() << ", plot " << (dir / "study.png").string() << ", page "
+      << (dir / "report.html").string() << "\n";
   return allOk(done) ? kExitOk : kExitRunsFailed;
 }
 

@@ -17,6 +17,7 @@
 #include "sets/run_plan.h"
 #include "sets/run_set.h"
 #include "sets/study_report.h"
+#include "report/set_report.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 
@@ -115,7 +116,9 @@ int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const s
   } catch (const std::exception& e) {
     log << "sweep: no plot (" << e.what() << ")\n";
   }
-  log << "sweep: table " << (dir / "sweep.csv").string() << ", plot " << (dir / "sweep.png").string() << "\n";
+  refreshSetReport(dir, log, "sweep");
+  log << "sweep: table " << (dir / "sweep.csv").string() << ", plot " << (dir / "sweep.png").string() << ", page "
+      << (dir / "report.html").string() << "\n";
   return allOk(done) ? kExitOk : kExitRunsFailed;
 }
 
@@ -247,6 +250,7 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
     }
   } catch (const std::runtime_error&) {
     writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
+    refreshSetReport(dir, log, "calibrate");
     return kExitInterrupted;
   }
   writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
@@ -255,6 +259,7 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
               {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
               {"status", std::isfinite(estimate) ? "done" : "no_estimate"}};
   detail::writeAtomically(dir / "calibration.json", detail::jsonText(out));
+  refreshSetReport(dir, log, "calibrate");
   if (!std::isfinite(estimate)) {  // the target was asked for and not found: not a success
     log << "error: calibrate: no estimate: " << how << "; widen the values\n";
     return kExitFailed;

@@ -1,6 +1,6 @@
 #pragma once
 // Running a scene: builds the world, steps it with progress on stderr, writes
-// run.h5 / .vtp series / checkpoint.h5 / results.json into the output directory.
+// run.h5 / .vtp series / checkpoint.h5 / results.json / report.html into the output directory.
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -25,8 +25,8 @@ enum ExitCode : int {
 enum class EarlierRun {
   Keep,     // write over it file by file (callers that make fresh folders themselves)
   Refuse,   // exit 2, nothing touched (`rocklab run` without --overwrite)
-  Replace,  // remove its outputs first (results.json, run.h5, checkpoint.h5, vtk/, frames/ and every
-            // .png .mp4 .avi .csv .json .partial .tmp), so no file of it sits beside the new run's
+  Replace,  // remove its outputs first (results.json, report.html, run.h5, checkpoint.h5, vtk/, frames/ and
+            // every .png .svg .mp4 .avi .csv .json .partial .tmp), so no file of it sits beside the new run's
 };
 
 struct RunOptions {
