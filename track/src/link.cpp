@@ -52,9 +52,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
   last_time_ = time;
 
   // 1. retire tracks unseen for more than max_missed_frames frames.
-  std::erase_if(active_, [&](int id) {
-    return frame - tracks_[id].points.back().frame - 1 > settings_.max_missed_frames;
-  });
+  std::erase_if(active_, [&](int id) { return retired(id, frame); });
 
   // 2. predict, 3. cost: squared distance, gated.
   const int n = static_cast<int>(active_.size()), m = static_cast<int>(detections.size());
@@ -105,6 +103,18 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     tracks_.push_back({id, {{frame, time, detections[j].centroid}}});
     active_.push_back(id);
   }
+}
+
+bool Linker::retired(int id, int frame) const {
+  return frame - tracks_[static_cast<std::size_t>(id)].points.back().frame - 1 > settings_.max_missed_frames;
+}
+
+std::vector<cv::Point2d> Linker::predictions(int frame, double time) const {
+  std::vector<cv::Point2d> out;
+  out.reserve(active_.size());
+  for (const int id : active_)
+    if (!retired(id, frame)) out.push_back(predict(tracks_[static_cast<std::size_t>(id)], time));
+  return out;
 }
 
 std::vector<Track> Linker::tracks() const { return tracks_; }

@@ -56,10 +56,17 @@ class Linker {
   /// where nothing was seen.
   void add(int frame, double time, const std::vector<Detection>& detections);
 
+  /// Where each track that add(frame, time, ...) could still extend expects its
+  /// marker (step 2), for the detector's prediction-seeded split (detect.h, 4a).
+  /// Does not change the linker.
+  std::vector<cv::Point2d> predictions(int frame, double time) const;
+
   /// Every track so far (ended or not), by id.
   std::vector<Track> tracks() const;
 
  private:
+  bool retired(int id, int frame) const;
+
   LinkSettings settings_;
   std::vector<Track> tracks_;  // index = id
   std::vector<int> active_;    // ids of tracks that may still be found
