@@ -44,7 +44,7 @@ void DetectorSettings::validate() const {
 namespace {
 
 // Component label under a predicted pixel: the pixel itself, else the nearest
-// labelled pixel within `reach` px (a prediction may fall just off a blob's edge);
+// labelled pixel within `reach` px;
 // 0 when none (outside the image or far from every component).
 int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
   if (!std::isfinite(prediction.x) || !std::isfinite(prediction.y)) return 0;
@@ -102,7 +102,9 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   // Predictions per component (stage 4a): which tracks expect to be in it.
   const double marker_radius = std::sqrt(reference / std::numbers::pi);
   std::vector<std::vector<cv::Point2d>> predicted(static_cast<std::size_t>(count));
-  const int reach = std::max(1, static_cast<int>(std::lround(0.5 * marker_radius)));
+  // Within a pixel (rounding): a prediction outside the blob belongs to a marker
+  // that is hidden or elsewhere, and must not cut a lone marker in two.
+  const int reach = 1;
   for (const cv::Point2d& p : predictions)
     if (const int label = labelNear(labels, p, reach); label > 0) predicted[static_cast<std::size_t>(label)].push_back(p);
 

@@ -34,6 +34,11 @@ void LinkSettings::validate() const {
     s << "link.max_distance_px must be a finite distance > 0 px (got " << max_distance_px << ')';
     throw std::invalid_argument(s.str());
   }
+  if (!(ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0)) {
+    std::ostringstream s;
+    s << "link.ambiguity_ratio must be in (0, 1] (got " << ambiguity_ratio << ')';
+    throw std::invalid_argument(s.str());
+  }
   if (max_missed_frames < 0)
     throw std::invalid_argument("link.max_missed_frames must be >= 0 (got " + std::to_string(max_missed_frames) + ")");
 }
@@ -90,13 +95,33 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     }
   }
 
-  // 5. update: matched tracks grow, the other detections start tracks.
-  std::vector<char> used(m, 0);
+  // 5. update: matched tracks grow, the other detections start tracks; a track
+  // whose match is not clearly its nearest detection ends.
+  std::vector<char> used(m, 0), closed(n, 0);
+  const double ratio2 = settings_.ambiguity_ratio * settings_.ambiguity_ratio;
   for (int i = 0; i < n; ++i) {
     if (match[i] < 0) continue;
+    if (ratio2 < 1.0) {
+      const double* row = &distance2[static_cast<std::size_t>(i) * m];
+      const double mine = row[match[i]];
+      bool ambiguous = false;
+      for (int j = 0; j < m && !ambiguous; ++j)  // another detection about as near
+        ambiguous = j != match[i] && row[j] <= gate2 && mine > ratio2 * row[j];
+      for (int k = 0; k < n && !ambiguous; ++k) {  // another track about as near its detection
+        const double other = distance2[static_cast<std::size_t>(k) * m + match[i]];
+        ambiguous = k != i && other <= gate2 && mine > ratio2 * other;
+      }
+      if (ambiguous) {
+        closed[i] = 1;
+        ambiguous_ends_.push_back(active_[i]);
+        continue;
+      }
+    }
     tracks_[active_[i]].points.push_back({frame, time, detections[match[i]].centroid});
     used[match[i]] = 1;
   }
+  for (int i = n - 1; i >= 0; --i)
+    if (closed[i]) active_.erase(active_.begin() + i);
   for (int j = 0; j < m; ++j) {
     if (used[j]) continue;
     const int id = static_cast<int>(tracks_.size());

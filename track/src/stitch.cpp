@@ -49,12 +49,17 @@ void StitchSettings::validate() const {
   if (!(ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0)) invalid("ambiguity_ratio", "must be in (0, 1]", ambiguity_ratio);
 }
 
-StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings& settings) {
+StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings& settings,
+                          const std::vector<int>& ended_ambiguous) {
   settings.validate();
   const std::size_t n = tracks.size();
+  auto closed = [&](const Track& t) {
+    return std::find(ended_ambiguous.begin(), ended_ambiguous.end(), t.id) != ended_ambiguous.end();
+  };
   // miss[a][b]: candidate A → B within both gates, else infinity.
   std::vector<double> miss(n * n, kNone);
   for (std::size_t a = 0; a < n; ++a) {
+    if (closed(tracks[a])) continue;
     const TrackPoint& end = tracks[a].points.back();
     for (std::size_t b = 0; b < n; ++b) {
       const TrackPoint& start = tracks[b].points.front();
@@ -99,7 +104,7 @@ StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings
   }
   // Unresolved: a track that had a candidate on a side and was not joined there.
   for (std::size_t k = 0; k < n; ++k)
-    if ((candidate_after[k] && next[k] == n) || (candidate_before[k] && !has_previous[k]))
+    if ((candidate_after[k] && next[k] == n) || (candidate_before[k] && !has_previous[k]) || closed(tracks[k]))
       out.unresolved.push_back(tracks[k].id);
   for (std::size_t k = 0; k < n; ++k) {
     if (has_previous[k]) continue;  // part of a chain started earlier

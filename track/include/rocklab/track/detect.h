@@ -9,8 +9,8 @@
 //   3. reference  — the area of one marker: expected_area_px, or (0) the median
 //                   area of this frame's components;
 //   4. split      — (a) prediction-seeded: a component into which two or more of the
-//                   given predictions fall (the pixel under the prediction, or the
-//                   nearest component pixel within half a marker radius) and larger
+//                   given predictions fall (the pixel under the prediction or one of
+//                   its 8 neighbours) and larger
 //                   than seeded_split_ratio × reference is cut into one piece per
 //                   prediction: k-means (Lloyd) on its pixel coordinates started at the
 //                   predictions, so each track keeps the piece nearest where it was

@@ -45,6 +45,9 @@ struct StitchResult {
 };
 
 /// Tracks as Linker::tracks() gives them (points by increasing frame, none empty).
-StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings& settings);
+/// `ended_ambiguous` (Linker::ambiguousEnds): tracks never continued by a stitch
+/// (their marker is in doubt already); they are listed unresolved.
+StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings& settings,
+                          const std::vector<int>& ended_ambiguous = {});
 
 }  // namespace rocklab::track
