@@ -82,9 +82,8 @@ nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerT
       {"unresolved_tracks", result.unresolved}};
 
   PlotSpec plot;
-  plot.title = "sub-pixel bias (pixel locking): tracked positions' fractional pixel part, " +
-               std::to_string(e.pairs) + " points";
-  plot.x_label = "position - nearest pixel centre (px)";
+  plot.title = "pixel locking: " + std::to_string(e.pairs) + " tracked positions";
+  plot.x_label = "tracked position - nearest pixel centre (px)";
   plot.y_label = "points per bin";
   std::vector<double> u(e.subpixel_u.begin(), e.subpixel_u.end()), v(e.subpixel_v.begin(), e.subpixel_v.end());
   plot.series = {PlotSeries{"u (across)", bin_centres, u, PlotSeries::Style::LinePoints},
