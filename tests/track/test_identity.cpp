@@ -185,3 +185,37 @@ TEST_CASE("the evaluation counts identity swaps, losses and errors against the t
   CHECK(clean.identity_swaps == 0);
   CHECK(clean.fraction_found == Approx(1.0));
 }
+
+TEST_CASE("a track whose blob comes apart between its prediction ends instead of guessing", "[track][identity]") {
+  // One marker standing still at (100, 100); then two detections 6 px either side.
+  LinkSettings s;
+  s.max_distance_px = 10.0;
+  s.ambiguity_ratio = 0.6;
+  Linker linker(s);
+  auto at = [](double u) {
+    Detection d;
+    d.centroid = {u, 100.0};
+    return d;
+  };
+  linker.add(0, 0.000, {at(100.0)});
+  linker.add(1, 0.002, {at(100.2)});
+  linker.add(2, 0.004, {at(94.0), at(106.4)});
+  CHECK(linker.ambiguousEnds() == std::vector<int>{0});
+  REQUIRE(linker.tracks().size() == 3);
+  CHECK(linker.tracks()[0].points.size() == 2);  // not continued on either piece
+  // Clearly nearer one piece: followed (ratio 2 / 8 < 0.6).
+  Linker clear(s);
+  clear.add(0, 0.000, {at(100.0)});
+  clear.add(1, 0.002, {at(100.2)});
+  clear.add(2, 0.004, {at(102.4), at(108.4)});
+  CHECK(clear.ambiguousEnds().empty());
+  CHECK(clear.tracks()[0].points.size() == 3);
+  // Off by default (ratio 1): the nearer is taken whatever the runner-up.
+  Linker off(LinkSettings{10.0});
+  off.add(0, 0.000, {at(100.0)});
+  off.add(1, 0.002, {at(100.2)});
+  off.add(2, 0.004, {at(94.0), at(106.4)});
+  CHECK(off.ambiguousEnds().empty());
+  CHECK_THROWS_WITH([] { LinkSettings bad; bad.ambiguity_ratio = 0.0; bad.validate(); }(),
+                    Catch::Contains("link.ambiguity_ratio"));
+}
