@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -34,11 +35,41 @@ void DetectorSettings::validate() const {
   if (!(min_fill >= 0.0 && min_fill <= 1.0)) invalid("min_fill", "must be in [0, 1]", min_fill);
   if (!(split_ratio > 1.0) || !std::isfinite(split_ratio)) invalid("split_ratio", "must be a finite ratio > 1", split_ratio);
   if (!(split_max_fill >= 0.0 && split_max_fill <= 1.0)) invalid("split_max_fill", "must be in [0, 1]", split_max_fill);
+  if (!(seeded_split_ratio >= 1.0) || !std::isfinite(seeded_split_ratio))
+    invalid("seeded_split_ratio", "must be a finite ratio >= 1", seeded_split_ratio);
   if (!(expected_area_px >= 0.0) || !std::isfinite(expected_area_px))
     invalid("expected_area_px", "must be >= 0 px (0 = median of the frame)", expected_area_px);
 }
 
+namespace {
+
+// Component label under a predicted pixel: the pixel itself, else the nearest
+// labelled pixel within `reach` px;
+// 0 when none (outside the image or far from every component).
+int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
+  if (!std::isfinite(prediction.x) || !std::isfinite(prediction.y)) return 0;
+  const long u = std::lround(prediction.x), v = std::lround(prediction.y);
+  int best = 0;
+  long bestD = std::numeric_limits<long>::max();
+  for (long dv = -reach; dv <= reach; ++dv)
+    for (long du = -reach; du <= reach; ++du) {
+      const long uu = u + du, vv = v + dv, d = du * du + dv * dv;
+      if (uu < 0 || vv < 0 || uu >= labels.cols || vv >= labels.rows || d >= bestD || d > long(reach) * reach)
+        continue;
+      const int label = labels.at<int>(static_cast<int>(vv), static_cast<int>(uu));
+      if (label != 0) best = label, bestD = d;
+    }
+  return best;
+}
+
+}  // namespace
+
 std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings) {
+  return detectMarkers(bgr, settings, {});
+}
+
+std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings,
+                                     const std::vector<cv::Point2d>& predictions) {
   settings.validate();
   if (bgr.empty() || bgr.type() != CV_8UC3)
     throw std::invalid_argument("detectMarkers: the image must be 8-bit BGR (CV_8UC3) and not empty");
@@ -68,6 +99,15 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     reference = *middle;
   }
 
+  // Predictions per component (stage 4a): which tracks expect to be in it.
+  const double marker_radius = std::sqrt(reference / std::numbers::pi);
+  std::vector<std::vector<cv::Point2d>> predicted(static_cast<std::size_t>(count));
+  // Within a pixel (rounding): a prediction outside the blob belongs to a marker
+  // that is hidden or elsewhere, and must not cut a lone marker in two.
+  const int reach = 1;
+  for (const cv::Point2d& p : predictions)
+    if (const int label = labelNear(labels, p, reach); label > 0) predicted[static_cast<std::size_t>(label)].push_back(p);
+
   std::vector<Detection> out;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const int label = candidates[c];
@@ -77,13 +117,17 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     // 5. measure the whole component; 4. split it if it is touching markers
     // (large and not round), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};
-    if (areas[c] > settings.split_ratio * reference && found[0].fill < settings.split_max_fill) {
+    const std::vector<cv::Point2d>& seeds = predicted[static_cast<std::size_t>(label)];
+    std::vector<detail::Blob> pieces;
+    if (seeds.size() >= 2 && areas[c] > settings.seeded_split_ratio * reference) {
+      pieces = detail::splitBlobAt(blob, seeds);
+    } else if (areas[c] > settings.split_ratio * reference && found[0].fill < settings.split_max_fill) {
       const int k = std::max(2, static_cast<int>(std::lround(areas[c] / reference)));
-      const std::vector<detail::Blob> pieces = detail::splitBlob(blob, k, std::sqrt(reference / std::numbers::pi));
-      if (pieces.size() > 1) {
-        found.clear();
-        for (const detail::Blob& piece : pieces) found.push_back(detail::measureBlob(bgr, piece));
-      }
+      pieces = detail::splitBlob(blob, k, marker_radius);
+    }
+    if (pieces.size() > 1) {
+      found.clear();
+      for (const detail::Blob& piece : pieces) found.push_back(detail::measureBlob(bgr, piece));
     }
     for (const Detection& d : found) {
       if (d.area_px < settings.min_area_px || d.area_px > settings.max_area_px) continue;

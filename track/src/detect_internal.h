@@ -28,4 +28,8 @@ Detection measureBlob(const cv::Mat& bgr, const Blob& blob);
 /// (fewer when fewer distance-transform peaks are found; the blob itself when one).
 std::vector<Blob> splitBlob(const Blob& blob, int pieces, double marker_radius_px);
 
+/// Stage 4a: one piece per seed (px, image coordinates): k-means on the core pixels
+/// started at the seeds; pieces left empty are dropped.
+std::vector<Blob> splitBlobAt(const Blob& blob, std::vector<cv::Point2d> seeds);
+
 }  // namespace rocklab::track::detail

@@ -34,6 +34,11 @@ void LinkSettings::validate() const {
     s << "link.max_distance_px must be a finite distance > 0 px (got " << max_distance_px << ')';
     throw std::invalid_argument(s.str());
   }
+  if (!(ambiguity_ratio > 0.0 && ambiguity_ratio <= 1.0)) {
+    std::ostringstream s;
+    s << "link.ambiguity_ratio must be in (0, 1] (got " << ambiguity_ratio << ')';
+    throw std::invalid_argument(s.str());
+  }
   if (max_missed_frames < 0)
     throw std::invalid_argument("link.max_missed_frames must be >= 0 (got " + std::to_string(max_missed_frames) + ")");
 }
@@ -52,9 +57,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
   last_time_ = time;
 
   // 1. retire tracks unseen for more than max_missed_frames frames.
-  std::erase_if(active_, [&](int id) {
-    return frame - tracks_[id].points.back().frame - 1 > settings_.max_missed_frames;
-  });
+  std::erase_if(active_, [&](int id) { return retired(id, frame); });
 
   // 2. predict, 3. cost: squared distance, gated.
   const int n = static_cast<int>(active_.size()), m = static_cast<int>(detections.size());
@@ -92,19 +95,51 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     }
   }
 
-  // 5. update: matched tracks grow, the other detections start tracks.
-  std::vector<char> used(m, 0);
+  // 5. update: matched tracks grow, the other detections start tracks; a track
+  // whose match is not clearly its nearest detection ends.
+  std::vector<char> used(m, 0), closed(n, 0);
+  const double ratio2 = settings_.ambiguity_ratio * settings_.ambiguity_ratio;
   for (int i = 0; i < n; ++i) {
     if (match[i] < 0) continue;
+    if (ratio2 < 1.0) {
+      const double* row = &distance2[static_cast<std::size_t>(i) * m];
+      const double mine = row[match[i]];
+      bool ambiguous = false;
+      for (int j = 0; j < m && !ambiguous; ++j)  // another detection about as near
+        ambiguous = j != match[i] && row[j] <= gate2 && mine > ratio2 * row[j];
+      for (int k = 0; k < n && !ambiguous; ++k) {  // another track about as near its detection
+        const double other = distance2[static_cast<std::size_t>(k) * m + match[i]];
+        ambiguous = k != i && other <= gate2 && mine > ratio2 * other;
+      }
+      if (ambiguous) {
+        closed[i] = 1;
+        ambiguous_ends_.push_back(active_[i]);
+        continue;
+      }
+    }
     tracks_[active_[i]].points.push_back({frame, time, detections[match[i]].centroid});
     used[match[i]] = 1;
   }
+  for (int i = n - 1; i >= 0; --i)
+    if (closed[i]) active_.erase(active_.begin() + i);
   for (int j = 0; j < m; ++j) {
     if (used[j]) continue;
     const int id = static_cast<int>(tracks_.size());
     tracks_.push_back({id, {{frame, time, detections[j].centroid}}});
     active_.push_back(id);
   }
+}
+
+bool Linker::retired(int id, int frame) const {
+  return frame - tracks_[static_cast<std::size_t>(id)].points.back().frame - 1 > settings_.max_missed_frames;
+}
+
+std::vector<cv::Point2d> Linker::predictions(int frame, double time) const {
+  std::vector<cv::Point2d> out;
+  out.reserve(active_.size());
+  for (const int id : active_)
+    if (!retired(id, frame)) out.push_back(predict(tracks_[static_cast<std::size_t>(id)], time));
+  return out;
 }
 
 std::vector<Track> Linker::tracks() const { return tracks_; }

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -43,7 +44,11 @@ std::vector<Blob> splitBlob(const Blob& blob, int pieces, double marker_radius_p
     cv::circle(distance, at, suppress, cv::Scalar(0), cv::FILLED);
   }
   if (centres.size() < 2) return {blob};
+  return splitBlobAt(blob, std::move(centres));
+}
 
+std::vector<Blob> splitBlobAt(const Blob& blob, std::vector<cv::Point2d> centres) {
+  if (centres.size() < 2 || blob.core.empty()) return {blob};
   // k-means (Lloyd) on the core pixel coordinates from those seeds.
   std::vector<std::size_t> owner(blob.core.size(), centres.size());
   for (int iteration = 0; iteration < 50; ++iteration) {

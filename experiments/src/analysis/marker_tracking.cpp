@@ -16,32 +16,51 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   const double depth = std::abs(camera_.toCamera(centre_on_plane).z());
   const double px_per_m = 0.5 * (camera_.fx + camera_.fy) / std::max(depth, 1e-9);
   const double r_px = px_per_m * radius;
-  detector_.expected_area_px = 3.14159265358979 * r_px * r_px;
+  marker_radius_px_ = r_px;
+  track::TrackerSettings s;
+  s.detector.expected_area_px = 3.14159265358979 * r_px * r_px;
   // Gate: what a marker can move between two frames beyond the constant-velocity
   // prediction (up to kMaxSpeed for one frame) plus centroid jitter (up to a radius:
   // the visible part of a clump changes as it turns), so a track does not jump to a
   // touching neighbour one diameter away.
   // A marker hidden for a moment (it turns its paint away, a neighbour covers it) is
-  // re-found for up to kMaxHidden.
-  constexpr double kMaxSpeed = 1.0;    // m/s: faster than any marker of the chute
-  constexpr double kMaxHidden = 0.05;  // s
-  track::LinkSettings link;
-  link.max_distance_px = r_px + px_per_m * kMaxSpeed / camera_.frameRate;
-  link.max_missed_frames = std::max(3, static_cast<int>(std::lround(kMaxHidden * camera_.frameRate)));
-  linker_ = track::Linker(link);
+  // re-found by the linker for up to kMaxHidden; longer, up to kMaxStitchGap, its
+  // track is stitched to one that starts within kStitchRadii marker radii of where
+  // it was heading (least-squares velocity of its last kStitchVelocityTime), unless
+  // two candidates are about as near (then both are reported unresolved).
+  constexpr double kMaxSpeed = 1.0;         // m/s: faster than any marker of the chute
+  constexpr double kMaxHidden = 0.02;       // s
+  constexpr double kMaxStitchGap = 0.15;    // s
+  constexpr double kStitchRadii = 1.0;      // marker radii
+  constexpr double kStitchVelocityTime = 0.02;  // s
+  // A track whose detection is not at most kAmbiguityRatio times as far as the next
+  // one (its blob came apart and its prediction lies between the pieces) ends there,
+  // as does a stitch with a rival about as near: unresolved, never a guess.
+  constexpr double kAmbiguityRatio = 0.6;
+  s.link.max_distance_px = r_px + px_per_m * kMaxSpeed / camera_.frameRate;
+  s.link.ambiguity_ratio = kAmbiguityRatio;
+  s.link.max_missed_frames = std::max(3, static_cast<int>(std::lround(kMaxHidden * camera_.frameRate)));
+  s.stitch.max_gap_frames = static_cast<int>(std::lround(kMaxStitchGap * camera_.frameRate));
+  s.stitch.max_distance_px = kStitchRadii * r_px;
+  s.stitch.ambiguity_ratio = kAmbiguityRatio;
+  s.stitch.velocity_points = std::max(2, static_cast<int>(std::lround(kStitchVelocityTime * camera_.frameRate)));
+  tracker_ = std::make_unique<track::Tracker>(s);
 }
 
 void MarkerTracking::addFrame(std::uint64_t frame, double time, const cv::Mat& bgr) {
   const auto t0 = std::chrono::steady_clock::now();
-  linker_.add(static_cast<int>(frame), time, track::detectMarkers(bgr, detector_));
-  ++frames_;
+  tracker_->add(static_cast<int>(frame), time, bgr);
+  frames_.emplace_back(static_cast<int>(frame), time);
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 MarkerTracking::Result MarkerTracking::finish() const {
   Result r;
   const auto t0 = std::chrono::steady_clock::now();
-  r.tracks = linker_.tracks();
+  track::StitchResult stitched = tracker_->finish();
+  r.tracks = std::move(stitched.tracks);
+  r.joins = std::move(stitched.joins);
+  r.unresolved = std::move(stitched.unresolved);
   for (const track::Track& t : r.tracks)
     r.velocities.push_back(track::trackVelocity(t, camera_, planePoint(), geometry::Vec3::UnitY(),
                                                 -geometry::Vec3::UnitX(), measure_distance_, onset_, reference_time_));

@@ -6,13 +6,15 @@
 // centres (y = marker plane, one marker radius behind the camera-side wall).
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "rocklab/geometry/camera.h"
-#include "rocklab/track/detect.h"
-#include "rocklab/track/link.h"
+#include "rocklab/track/stitch.h"
+#include "rocklab/track/tracker.h"
 #include "rocklab/track/velocity.h"
 
 namespace rocklab::experiments {
@@ -23,7 +25,8 @@ class MarkerTracking {
   MarkerTracking(const geometry::Camera& camera, double onset, double measure_distance);
   /// Where the markers sit (y of their centres: against the camera-side wall) and
   /// their equivalent radius, as the lab knows its painted pebbles: gives the
-  /// expected blob area, so that touching markers are split into two.
+  /// expected blob area (touching markers are split), the linking gate and the
+  /// stitching gate.
   void setMarkers(double plane_y, double radius);
   /// The camera the tracker works with (e.g. the one recovered by calibration);
   /// call before setMarkers.
@@ -34,23 +37,26 @@ class MarkerTracking {
   void addFrame(std::uint64_t frame, double time, const cv::Mat& bgr);
 
   struct Result {
-    std::vector<track::Track> tracks;
+    std::vector<track::Track> tracks;               // stitched
     std::vector<track::MarkerVelocity> velocities;  // one per track
-    std::uint64_t frames = 0;
-    double seconds = 0.0;  // wall time of detection and linking
+    std::vector<track::StitchJoin> joins;
+    std::vector<int> unresolved;                    // track ids (before stitching) left apart
+    std::vector<std::pair<int, double>> frames;     // (frame, time s) of every tracked frame
+    double seconds = 0.0;  // wall time of detection, linking and stitching
   };
   Result finish() const;
   const geometry::Camera& camera() const { return camera_; }
   geometry::Vec3 planePoint() const { return {0.0, plane_y_, 0.0}; }
+  double markerRadiusPx() const { return marker_radius_px_; }
+  const track::TrackerSettings& settings() const { return tracker_->settings(); }
 
  private:
   geometry::Camera camera_;
   double onset_, measure_distance_;
-  double plane_y_ = 0.0;
+  double plane_y_ = 0.0, marker_radius_px_ = 0.0;
   double reference_time_ = std::numeric_limits<double>::quiet_NaN();
-  track::DetectorSettings detector_;
-  track::Linker linker_;
-  std::uint64_t frames_ = 0;
+  std::unique_ptr<track::Tracker> tracker_;
+  std::vector<std::pair<int, double>> frames_;
   double seconds_ = 0.0;
 };
 

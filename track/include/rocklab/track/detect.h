@@ -8,8 +8,15 @@
 //   2. components — 8-connected components with their pixel counts;
 //   3. reference  — the area of one marker: expected_area_px, or (0) the median
 //                   area of this frame's components;
-//   4. split      — a component larger than split_ratio × reference and less round
-//                   than split_max_fill (one disc fills ~0.9 of its enclosing circle,
+//   4. split      — (a) prediction-seeded: a component into which two or more of the
+//                   given predictions fall (the pixel under the prediction or one of
+//                   its 8 neighbours) and larger
+//                   than seeded_split_ratio × reference is cut into one piece per
+//                   prediction: k-means (Lloyd) on its pixel coordinates started at the
+//                   predictions, so each track keeps the piece nearest where it was
+//                   going (touching markers that move together stay apart);
+//                   (b) otherwise, by size: a component larger than split_ratio ×
+//                   reference and less round than split_max_fill (one disc fills ~0.9 of its enclosing circle,
 //                   two touching discs 0.5, three or four in a clump 0.65–0.7) is
 //                   touching markers: k = round(area / reference) pieces, seeded at the k
 //                   highest distance-transform peaks (each peak suppresses a disc
@@ -52,6 +59,10 @@ struct DetectorSettings {
   // split_max_fill is split [-]; a big round blob is one big marker.
   double split_ratio = 1.8;
   double split_max_fill = 0.8;
+  // A component that two or more predictions fall into is cut at them when its
+  // area exceeds seeded_split_ratio × the reference [-] (two markers half hidden
+  // behind each other still cover more than one; a single marker never does).
+  double seeded_split_ratio = 1.25;
   // Area of one marker [px²]; 0 = the median component area of each frame (needs
   // a frame with mostly single markers; with one component nothing is ever split).
   double expected_area_px = 0.0;
@@ -64,5 +75,10 @@ struct DetectorSettings {
 /// another type throws std::invalid_argument. No marker → an empty list.
 /// Detections are in row-major order of their components (top to bottom).
 std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings = {});
+
+/// The same, with the tracks' predicted pixels for this frame (Linker::predictions):
+/// a component two or more predictions fall into is split at them (stage 4a).
+std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings,
+                                     const std::vector<cv::Point2d>& predictions);
 
 }  // namespace rocklab::track
