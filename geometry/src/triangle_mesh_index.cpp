@@ -5,6 +5,8 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include <boost/iterator/function_output_iterator.hpp>
+
 #include <algorithm>
 #include <array>
 #include <map>
@@ -94,13 +96,42 @@ Vec3 TriangleMeshIndex::closestPoint(const Vec3& p) const {
   return closestPointOnTriangle(p, v[f[0]], v[f[1]], v[f[2]]);
 }
 
+namespace {
+
+/// Calls visit(triangle index) for every triangle whose box meets p's box of half-size r.
+template <class Visit>
+void forTrianglesNear(const CgalTree& tree, const std::vector<Triangle>& triangles, const Vec3& p, double r,
+                      Visit&& visit) {
+  const CGAL::Bbox_3 box(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r);
+  tree.all_intersected_primitives(box, boost::make_function_output_iterator([&](const Primitive::Id& id) {
+                                    visit(static_cast<std::size_t>(id - triangles.begin()));
+                                  }));
+}
+
+}  // namespace
+
+bool TriangleMeshIndex::closestPointWithin(const Vec3& p, double radius, Vec3& closest) const {
+  const Tree& t = *tree_;
+  double best = radius * radius;
+  std::size_t best_triangle = 0;
+  bool found = false;
+  forTrianglesNear(t.tree, t.triangles, p, radius, [&](std::size_t k) {
+    const Vec3 q = t.closestOn(k, p);
+    const double d2 = (q - p).squaredNorm();
+    if (d2 < best || (found && d2 == best && k < best_triangle)) {
+      best = d2;
+      best_triangle = k;
+      closest = q;
+      found = true;
+    }
+  });
+  return found;
+}
+
 std::vector<TriangleMeshIndex::Touch> TriangleMeshIndex::touches(const Vec3& p, double r) const {
   const Tree& t = *tree_;
   std::vector<std::size_t> near;
-  const CGAL::Bbox_3 box(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r);
-  std::vector<Primitive::Id> hits;
-  t.tree.all_intersected_primitives(box, std::back_inserter(hits));
-  for (const auto& id : hits) near.push_back(static_cast<std::size_t>(id - t.triangles.begin()));
+  forTrianglesNear(t.tree, t.triangles, p, r, [&](std::size_t k) { near.push_back(k); });
   std::sort(near.begin(), near.end());
 
   std::vector<Touch> candidates;

@@ -66,6 +66,16 @@ class WallRuntime {
     return (toBody(x) - closestInBody(w, toBody(x))).norm();
   }
 
+  /// Whether x is nearer than `range` to the wall (planes: signed distance, so a
+  /// point behind is near). Meshes visit only the triangles near x.
+  bool within(const Wall& w, const Vec3& x, double range) const {
+    if (w.shape == WallShape::Mesh) {
+      Vec3 q;
+      return mesh_index_.closestPointWithin(toBody(x), range, q);
+    }
+    return distance(w, x) < range;
+  }
+
   /// Contact of a ball (centre x, radius r) with the wall; false when apart.
   bool contact(const Wall& w, const Vec3& x, double r, WallContact& out) const {
     const Vec3 xb = toBody(x);
@@ -77,7 +87,12 @@ class WallRuntime {
       out.overlap = r - d;
       return true;
     }
-    const Vec3 q = closestInBody(w, xb);
+    Vec3 q;
+    if (w.shape == WallShape::Mesh) {
+      if (!mesh_index_.closestPointWithin(xb, r, q)) return false;  // visits only the triangles near the ball
+    } else {
+      q = closestInBody(w, xb);
+    }
     const Vec3 diff = xb - q;
     const double d2 = diff.squaredNorm();
     if (d2 >= r * r) return false;

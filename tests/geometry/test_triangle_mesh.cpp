@@ -45,6 +45,12 @@ TEST_CASE("closest points through the AABB tree equal the brute force", "[geomet
       worst = std::max(worst, (brute - fast).norm());
       // The distance can tie between triangles; the point then is the same.
       CHECK((fast - p).norm() == Approx((brute - p).norm()).margin(1e-13));
+      // Within a radius: only nearby triangles, the brute force's point exactly.
+      const double radius = 0.01 * (1 + k % 5);
+      Vec3 near = Vec3::Zero();
+      const bool within = index.closestPointWithin(p, radius, near);
+      CHECK(within == ((brute - p).squaredNorm() < radius * radius));
+      if (within) CHECK(near == brute);
     }
     INFO("triangles " << mesh.triangleCount());
     CHECK(worst < 1e-12);

@@ -27,6 +27,11 @@ class TriangleMeshIndex {
   Vec3 closestPoint(const Vec3& p) const;
   /// Index (into mesh.triangles) of a triangle holding that point.
   std::size_t closestTriangle(const Vec3& p) const;
+  /// The closest point on the mesh if it is nearer to p than `radius` (false
+  /// otherwise): only the triangles whose boxes meet p's box are visited, and the
+  /// point is the brute force's (the first triangle in mesh order on a tie), so a
+  /// ball's contact costs a few triangles whatever the mesh.
+  bool closestPointWithin(const Vec3& p, double radius, Vec3& closest) const;
 
   /// A point where a ball centred at p touches the surface.
   struct Touch {
