@@ -3,11 +3,14 @@
 //
 // Geometry is stored in the wall's rest frame (Model::walls); a moving wall maps
 // the ball centre into that frame (bodyFromWorld), finds the closest point there
-// and maps the result back (worldFromBody). Static walls skip both maps.
+// and maps the result back (worldFromBody). Walls whose surface does not move
+// skip both maps; a wall that only spins (model.h WallMotion) has a velocity but
+// no pose change.
 #include <cmath>
 #include <numbers>
 
 #include "rocklab/geometry/closest_point.h"
+#include "rocklab/geometry/triangle_mesh_index.h"
 #include "rocklab/sim/model.h"
 #include "rocklab/sim/wall_motion.h"
 
@@ -25,7 +28,8 @@ class WallRuntime {
   bool active = false;
 
   void setup(const Wall& w) {
-    is_static_ = w.motion.isStatic();
+    is_static_ = !w.motion.surfaceMoves();
+    moves_material_ = !w.motion.isStatic();
     if (w.shape == WallShape::Plane) {
       unit_normal_ = w.normal.normalized();
     } else if (w.shape == WallShape::Polygon) {
@@ -34,37 +38,42 @@ class WallRuntime {
     } else {
       unit_normal_ = Vec3::UnitZ();
       for (const Vec3& v : w.mesh.vertices) extent_ = std::max(extent_, (v - w.motion.pivot).norm());
+      mesh_index_ = geometry::TriangleMeshIndex(w.mesh);
     }
   }
 
   /// Pose and activity at time t.
   void update(const Wall& w, double t) {
     active = w.activeAt(t);
-    if (is_static_) return;
-    const WallPose pose = wallPoseAt(w.motion, t);
-    translation_ = pose.translation;
-    velocity_ = pose.velocity;
-    omega_ = pose.omega;
-    angle_ = pose.angle;
-    rotation_ = pose.rotation;
-    centre_ = pose.pivot + translation_;
-    pivot_ = pose.pivot;
+    if (!moves_material_) return;
+    pose_ = wallPoseAt(w.motion, t);
+    centre_ = pose_.pivot + pose_.translation;
   }
 
   void setReference() {
-    ref_translation_ = translation_;
-    ref_angle_ = angle_;
+    ref_translation_ = pose_.translation;
+    ref_angle_ = pose_.angle;
   }
   /// Upper bound of how far any point of the wall moved since setReference().
   double displacementSinceReference() const {
     if (is_static_) return 0.0;
-    return (translation_ - ref_translation_).norm() + std::abs(angle_ - ref_angle_) * extent_;
+    return (pose_.translation - ref_translation_).norm() + std::abs(pose_.angle - ref_angle_) * extent_;
   }
 
   /// Distance from x to the wall surface (planes: signed, negative behind).
   double distance(const Wall& w, const Vec3& x) const {
     if (w.shape == WallShape::Plane) return (toBody(x) - w.point).dot(unit_normal_);
     return (toBody(x) - closestInBody(w, toBody(x))).norm();
+  }
+
+  /// Whether x is nearer than `range` to the wall (planes: signed distance, so a
+  /// point behind is near). Meshes visit only the triangles near x.
+  bool within(const Wall& w, const Vec3& x, double range) const {
+    if (w.shape == WallShape::Mesh) {
+      Vec3 q;
+      return mesh_index_.closestPointWithin(toBody(x), range, q);
+    }
+    return distance(w, x) < range;
   }
 
   /// Contact of a ball (centre x, radius r) with the wall; false when apart.
@@ -78,7 +87,12 @@ class WallRuntime {
       out.overlap = r - d;
       return true;
     }
-    const Vec3 q = closestInBody(w, xb);
+    Vec3 q;
+    if (w.shape == WallShape::Mesh) {
+      if (!mesh_index_.closestPointWithin(xb, r, q)) return false;  // visits only the triangles near the ball
+    } else {
+      q = closestInBody(w, xb);
+    }
     const Vec3 diff = xb - q;
     const double d2 = diff.squaredNorm();
     if (d2 >= r * r) return false;
@@ -92,28 +106,28 @@ class WallRuntime {
 
   /// Velocity of the wall material at world point x.
   Vec3 velocityAt(const Vec3& x) const {
-    if (is_static_) return Vec3::Zero();
-    return velocity_ + omega_.cross(x - centre_);
+    if (!moves_material_) return Vec3::Zero();
+    return pose_.velocityAt(x);
   }
 
  private:
   Vec3 toBody(const Vec3& x) const {
     if (is_static_) return x;
-    return rotation_.transpose() * (x - centre_) + pivot_;
+    return pose_.rotation.transpose() * (x - centre_) + pose_.pivot;
   }
-  Vec3 toWorldDirection(const Vec3& v) const { return is_static_ ? v : Vec3(rotation_ * v); }
-  static Vec3 closestInBody(const Wall& w, const Vec3& xb) {
+  Vec3 toWorldDirection(const Vec3& v) const { return is_static_ ? v : Vec3(pose_.rotation * v); }
+  Vec3 closestInBody(const Wall& w, const Vec3& xb) const {
     if (w.shape == WallShape::Polygon) return geometry::closestPointOnConvexPolygon(xb, w.vertices);
-    return w.mesh.closestPoint(xb);
+    return mesh_index_.closestPoint(xb);
   }
 
-  bool is_static_ = true;
+  bool is_static_ = true;        // the surface never moves: no pose maps
+  bool moves_material_ = false;  // a velocity (the surface's motion or a spin)
   Vec3 unit_normal_ = Vec3::UnitZ();
   double extent_ = 0.0;  // m, farthest vertex from the pivot
-  Vec3 translation_ = Vec3::Zero(), velocity_ = Vec3::Zero(), omega_ = Vec3::Zero();
-  Vec3 centre_ = Vec3::Zero(), pivot_ = Vec3::Zero();
-  double angle_ = 0.0;
-  geometry::Mat3 rotation_ = geometry::Mat3::Identity();
+  geometry::TriangleMeshIndex mesh_index_;  // mesh walls: closest points through an AABB tree
+  WallPose pose_;                 // at the current time (moving walls only)
+  Vec3 centre_ = Vec3::Zero();    // pivot + translation
   Vec3 ref_translation_ = Vec3::Zero();
   double ref_angle_ = 0.0;
 };

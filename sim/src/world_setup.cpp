@@ -1,5 +1,6 @@
 #include "world_impl.h"
 
+#include <cmath>
 #include <numbers>
 #include <sstream>
 
@@ -36,9 +37,12 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
     if (w.material < 0 || w.material >= nm) return where + ": unknown material";
     if (w.shape == WallShape::Plane) {
       if (!(w.normal.norm() > 0)) return where + ": normal must not be zero";
-      if (!w.motion.angular_velocity.isZero(0))
-        return where + ": an infinite plane cannot rotate; use a polygon";
+      if (!w.motion.angular_velocity.isZero(0) || w.motion.spin_rate != 0.0)
+        return where + ": an infinite plane cannot rotate or spin; use a polygon";
     }
+    if (w.motion.spin_rate != 0.0 && !(std::isfinite(w.motion.spin_rate) && w.motion.spin_axis.norm() > 0 &&
+                                        w.motion.spin_axis.allFinite() && w.motion.spin_point.allFinite()))
+      return where + ": a spin needs a finite rate, a non-zero spin_axis and a finite spin_point";
     if (w.shape == WallShape::Polygon)
       if (const std::string problem = polygonProblem(w.vertices); !problem.empty()) return where + ": " + problem;
     if (w.shape == WallShape::Mesh) {

@@ -5,9 +5,12 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "cli_support.h"
 #include "rocklab/experiments/scene.h"
+#include "rocklab/geometry/mantle_motion.h"
+#include "rocklab/sim/wall_motion.h"
 
 namespace fs = std::filesystem;
 using namespace rocklab::experiments;
@@ -41,9 +44,14 @@ TEST_CASE("[crusher] builds the Table 6.1 chamber as mesh walls and refuses bad 
   CHECK(s.model.walls[3].name == "crusher.upper_concave");
   for (const auto& w : s.model.walls) {
     CHECK(w.shape == rocklab::sim::WallShape::Mesh);
-    CHECK(w.motion.isStatic());  // the engine cannot move the mantle yet (docs/crusher.md)
     CHECK(w.mesh.validate().empty());
   }
+  // The mantle and its cap gyrate and spin; the concaves stay.
+  CHECK(!s.model.walls[0].motion.isStatic());
+  CHECK(!s.model.walls[1].motion.isStatic());
+  CHECK(s.model.walls[2].motion.isStatic());
+  CHECK(s.model.walls[3].motion.isStatic());
+  CHECK(loadScene(kCrusherScene, {"crusher.eccentric_speed_rpm=0"}).model.walls[0].motion.isStatic());
   CHECK(loadScene(kCrusherScene, {"crusher.walls=false"}).model.walls.empty());
   CHECK(loadScene(kCrusherScene, {"crusher.pivot=\"eq6-1\""}).crusher->spec.pivot ==
         rocklab::geometry::PivotPlacement::Eq61);
@@ -81,5 +89,87 @@ TEST_CASE("crusher-geometry prints, draws the section and writes results.json, a
   CHECK(!fs::exists(out2));
   CHECK(test::cli({"crusher-geometry", kCrusherScene, "--out", out2.string(), "--set", "crusher.css=0.06"}) == 2);
   CHECK(!fs::exists(out2));
+  fs::remove_all(out);
+}
+
+TEST_CASE("the crusher's mantle wall: gyration in the pose, Eq 6-9 spin in the velocity only, no drift", "[scene][crusher]") {
+  using rocklab::geometry::Vec3;
+  const Scene s = loadScene(kCrusherScene);
+  const rocklab::sim::WallMotion& motion = s.model.walls[0].motion;
+  const auto g = rocklab::geometry::coneCrusherGeometry(s.crusher->spec);
+  const auto m = rocklab::geometry::mantleMotion(g, s.crusher->eccentric_rpm, s.crusher->spin_sense);
+  const double period = 2 * std::numbers::pi / m.eccentric_speed;
+  const Vec3 edge0 = g.mantle_bottom_edge.world();
+  const double rim_speed = m.eccentric_speed * g.R_bot_m;
+
+  // The engine's wall velocity is the reference's field (two rigid rotations), at
+  // any point and time; the closed-side bottom edge, carried round by the
+  // gyration, rolls (Eq 6-9: to 0.052 % of omega_ecc R, see docs/crusher.md).
+  for (const double t : {0.0, 0.013, 0.37, 5.002}) {
+    const rocklab::sim::WallPose pose = rocklab::sim::wallPoseAt(motion, t);
+    for (const Vec3& x : {Vec3(0.1, 0.02, 0.05), Vec3(-0.12, 0.07, 0.09), edge0}) {
+      const Vec3 expected = rocklab::geometry::mantleVelocityAt(m, t, x);
+      CHECK((pose.velocityAt(x) - expected).norm() < 1e-9 * rim_speed);
+    }
+    CHECK(pose.velocityAt(pose.place(edge0)).norm() < 6e-4 * rim_speed);
+  }
+  // With the spin in the same sense the edge slides at about twice the rim speed.
+  const Scene same = loadScene(kCrusherScene, {"crusher.spin_sense=\"same\""});
+  const auto same_pose = rocklab::sim::wallPoseAt(same.model.walls[0].motion, 0.01);
+  CHECK(same_pose.velocityAt(same_pose.place(edge0)).norm() > 1.9 * rim_speed);
+
+  // After whole gyrations every mantle vertex is back where it started: the spin
+  // (which would turn it by -N 2 pi e/R) is not in the pose and the angle is
+  // reduced to one turn.
+  for (const int revolutions : {1, 1000, 100000}) {
+    const rocklab::sim::WallPose pose = rocklab::sim::wallPoseAt(motion, revolutions * period);
+    double worst = 0;
+    for (const Vec3& v : s.model.walls[0].mesh.vertices) worst = std::max(worst, (pose.place(v) - v).norm());
+    CHECK(worst < 1e-9);
+  }
+  // Half a gyration puts the closed-side edge on the open side.
+  const Vec3 half = rocklab::sim::wallPoseAt(motion, 0.5 * period).place(edge0);
+  CHECK(half.x() == Approx(-edge0.x()).margin(1e-12));
+}
+
+TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving chamber and is discharged", "[cli][crusher]") {
+  // The PBM scene with six 8-9 mm spheres (finer than the 11.6 mm closed-side
+  // gap), soft contacts (a coarse step) and the stop wall gone at 0.02 s: every
+  // ball must reach the discharge below the chamber, its size recorded, and the
+  // run end there (the chamber is empty). The walls' ParaView series shows the
+  // mantle at its pose.
+  const std::string scene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/cone-crusher-pbm.toml";
+  const fs::path out = test::scratchDir("crusher-run");
+  std::vector<std::string> args{"run", scene, "--out", out.string(), "--threads", "1", "--quiet",
+                                "--set", "crusher.release_time=0.02", "--set", "scene.end_time=2.0",
+                                "--set", "output.frame_interval=0.05"};
+  for (const char* m : {"rock_small", "rock_medium", "rock_large"})
+    for (const char* k : {"kn", "ks"}) args.insert(args.end(), {"--set", std::string("materials.") + m + "." + k + "=1e7"});
+  for (int s = 0; s < 3; ++s) {
+    const std::string p = "particles." + std::to_string(s) + ".";
+    const double z = 0.165 + 0.035 * s;
+    args.insert(args.end(), {"--set", p + "count=2", "--set", p + "radius_min=0.004", "--set", p + "radius_max=0.0045",
+                             "--set", p + "region_min=[-0.045,-0.045," + std::to_string(z) + "]",
+                             "--set", p + "region_max=[0.045,0.045," + std::to_string(z + 0.035) + "]"});
+  }
+  REQUIRE(test::cli(args) == 0);
+  std::ifstream in(out / "results.json");
+  const auto r = nlohmann::json::parse(in);
+  CHECK(r["experiment"] == "crusher");
+  CHECK(!r.contains("experiment_status"));  // ended by the empty chamber, not by end_time
+  const auto& c = r["crusher"];
+  INFO(c.dump());
+  CHECK(c["feed_balls"] == 6);
+  CHECK(c["discharged_balls"] == 6);
+  CHECK(c["empty"] == true);
+  CHECK(c["discharged_mass_kg"].get<double>() == Approx(c["feed_mass_kg"].get<double>()).epsilon(1e-12));
+  CHECK(c["first_discharge_s"].get<double>() > 0.1);  // not before the stop wall went and the fall
+  const auto& psd = c["psd"];
+  CHECK(psd.front()["passing"] == 0.0);  // 2 mm: nothing finer
+  CHECK(psd.back()["passing"] == 1.0);   // 31.5 mm: everything
+  const std::string product = test::slurp(out / "product.csv");
+  CHECK(std::count(product.begin(), product.end(), '\n') == 7);  // header + 6 balls
+  CHECK(fs::exists(out / "vtk/walls.pvd"));
+  CHECK(fs::exists(out / "vtk/walls_000001.vtp"));
   fs::remove_all(out);
 }

@@ -1,8 +1,13 @@
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <string>
 
+#include "rocklab/geometry/frustum_mesh.h"
+#include "rocklab/geometry/mesh_generate.h"
+#include "rocklab/geometry/packing.h"
 #include "rocklab/geometry/triangle_mesh.h"
+#include "rocklab/geometry/triangle_mesh_index.h"
 
 using namespace rocklab::geometry;
 
@@ -13,4 +18,92 @@ TEST_CASE("mesh validation names the problem", "[geometry]") {
   CHECK(mesh.validate() == "triangle 0 has zero area");
   mesh.triangles = {{0, 1, 5}};
   CHECK(mesh.validate().find("refers to vertex 5") != std::string::npos);
+}
+
+TEST_CASE("closest points through the AABB tree equal the brute force", "[geometry]") {
+  // The crusher's concave (a frustum seen from inside: every query point near
+  // its concave side) and a 5120-triangle pebble, from points all around,
+  // inside, on and far from the surface.
+  FrustumSpec concave;
+  concave.bottom_centre = Vec3(0, 0, 0.01);
+  concave.top_centre = Vec3(0, 0, 0.06);
+  concave.bottom_radius = 0.165;
+  concave.top_radius = 0.128;
+  concave.facing = FrustumFacing::TowardAxis;
+  for (const TriangleMesh& mesh : {frustumMesh(concave), generateParticle(ParticleKind::Crushed, 7, 4)}) {
+    const TriangleMeshIndex index(mesh);
+    const AABB box = mesh.bounds();
+    const Vec3 size = box.hi - box.lo;
+    Rng rng(11);
+    double worst = 0;
+    for (int k = 0; k < 3000; ++k) {
+      const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
+      Vec3 p = box.lo - 0.2 * size + 1.4 * size.cwiseProduct(u);
+      if (k % 10 == 0) p = mesh.vertices[k % mesh.vertices.size()];  // on a vertex
+      const Vec3 brute = mesh.closestPoint(p);
+      const Vec3 fast = index.closestPoint(p);
+      worst = std::max(worst, (brute - fast).norm());
+      // The distance can tie between triangles; the point then is the same.
+      CHECK((fast - p).norm() == Approx((brute - p).norm()).margin(1e-13));
+      // Within a radius: only nearby triangles, the brute force's point exactly.
+      const double radius = 0.01 * (1 + k % 5);
+      Vec3 near = Vec3::Zero();
+      const bool within = index.closestPointWithin(p, radius, near);
+      CHECK(within == ((brute - p).squaredNorm() < radius * radius));
+      if (within) CHECK(near == brute);
+    }
+    INFO("triangles " << mesh.triangleCount());
+    CHECK(worst < 1e-12);
+  }
+}
+
+TEST_CASE("a ball's touches on a mesh - one per contact and two in a concave crease", "[geometry]") {
+  // A flat 3 x 3 grid (two triangles per square, a vertex where six meet): a ball
+  // over a face, an edge, a diagonal or the centre vertex touches it once.
+  TriangleMesh flat;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) flat.vertices.emplace_back(0.2 * i, 0.2 * j, 0.0);
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const std::uint32_t a = j * 3 + i, b = a + 1, c = a + 4, d = a + 3;
+      flat.triangles.push_back({a, b, c});
+      flat.triangles.push_back({a, c, d});
+    }
+  const TriangleMeshIndex grid(flat);
+  for (const Vec3& p : {Vec3(0.05, -0.11, 0.009), Vec3(-0.1, -0.1, 0.009), Vec3(0, 0, 0.009), Vec3(0.001, 0, 0.009),
+                        Vec3(0, 0.1, 0.009)}) {
+    INFO("ball at " << p.transpose());
+    const auto touches = grid.touches(p, 0.01);
+    REQUIRE(touches.size() == 1);
+    CHECK(touches[0].distance == Approx(0.009).margin(1e-15));
+  }
+  CHECK(grid.touches(Vec3(0.05, 0.05, 0.011), 0.01).empty());
+
+  // A V-shaped groove (two faces at 90 degrees, concave seen from above, each
+  // face two triangles): a ball resting in it touches both faces, each once,
+  // with the normals of the faces; moved up one face, only that face.
+  TriangleMesh groove;
+  groove.vertices = {{-0.1, -0.2, 0.1}, {-0.1, 0.2, 0.1}, {0, -0.2, 0}, {0, 0.2, 0}, {0.1, -0.2, 0.1}, {0.1, 0.2, 0.1}};
+  groove.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
+  const TriangleMeshIndex v(groove);
+  const double r = 0.01;
+  const Vec3 rest(0, 0.03, r * std::sqrt(2.0) - 1e-4);  // overlapping each face by 1e-4 / sqrt(2)
+  const auto both = v.touches(rest, r);
+  REQUIRE(both.size() == 2);
+  CHECK(std::abs((rest - both[0].point).normalized().dot((rest - both[1].point).normalized())) < 1e-9);  // 90 deg apart
+  const Vec3 up_left(-0.03, 0.03, 0.03 + r * std::sqrt(2.0) - 1e-4);
+  CHECK(v.touches(up_left, r).size() == 1);
+  CHECK(v.touches(Vec3(0, 0.0, r - 1e-4), r).size() == 2);  // right above the crease line
+  // A convex ridge (the groove upside down) and a cone's apex: one touch each.
+  TriangleMesh ridge = groove;
+  for (Vec3& p : ridge.vertices) p.z() = -p.z();
+  CHECK(TriangleMeshIndex(ridge).touches(Vec3(0, 0.03, 0.009), r).size() == 1);
+  FrustumSpec cone;
+  cone.bottom_centre = Vec3::Zero();
+  cone.top_centre = Vec3(0, 0, 0.05);
+  cone.bottom_radius = 0.1;
+  cone.top_radius = 0.0;
+  const auto apex = TriangleMeshIndex(frustumMesh(cone)).touches(Vec3(0, 0, 0.059), r);
+  REQUIRE(apex.size() == 1);
+  CHECK(apex[0].distance == Approx(0.009).margin(1e-12));
 }

@@ -1,5 +1,6 @@
 // Output modules: run file (HDF5), ParaView series (.vtp + .pvd), checkpoint.
 #include <H5Cpp.h>
+#include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -24,7 +25,9 @@
 
 #include "rocklab/sim/output/checkpoint.h"
 #include "rocklab/sim/output/run_file.h"
+#include "rocklab/geometry/frustum_mesh.h"
 #include "rocklab/sim/output/vtk_series.h"
+#include "rocklab/sim/wall_motion.h"
 
 namespace {
 
@@ -667,4 +670,62 @@ TEST_CASE("output: checkpoint errors name the file and the problem", "[output]")
                       Contains(path.string()) && Contains("mass"));
     CHECK(fs::is_empty(dir.path()));  // neither the checkpoint nor a temporary file
   }
+}
+
+TEST_CASE("output: vtk wall series - moving walls at their pose, the spin in the velocity", "[output]") {
+  // A gyrating, spinning frustum (the crusher mantle's kind of motion), a static
+  // polygon and an infinite plane (not drawn), written at two times and read back.
+  rocklab::geometry::FrustumSpec cone;
+  cone.bottom_centre = Vec3(0.004, 0, 0);
+  cone.top_centre = Vec3(0.001, 0, 0.1);
+  cone.bottom_radius = 0.15;
+  cone.top_radius = 0.04;
+  cone.segments = 24;
+  rocklab::sim::Model model;
+  rocklab::sim::Wall mantle;
+  mantle.name = "mantle";
+  mantle.shape = rocklab::sim::WallShape::Mesh;
+  mantle.mesh = rocklab::geometry::frustumMesh(cone);
+  mantle.motion.angular_velocity = Vec3(0, 0, 31.4);
+  mantle.motion.spin_rate = -32.3;
+  mantle.motion.spin_axis = (cone.top_centre - cone.bottom_centre).normalized();
+  mantle.motion.spin_point = cone.bottom_centre;
+  rocklab::sim::Wall gate;
+  gate.name = "gate";
+  gate.shape = rocklab::sim::WallShape::Polygon;
+  gate.vertices = {{-0.2, -0.2, 0.2}, {0.2, -0.2, 0.2}, {0.2, 0.2, 0.2}, {-0.2, 0.2, 0.2}};
+  rocklab::sim::Wall floor;
+  floor.name = "floor";
+  model.walls = {mantle, gate, floor};
+
+  TempDir dir;
+  output::VtkSeries series(dir / "vtk", "walls");
+  const std::vector<double> times{0.0, 0.05};
+  for (const double t : times) series.writeWalls(model, t);
+  CHECK(fs::exists(dir / "vtk/walls.pvd"));
+  const std::size_t nm = mantle.mesh.vertices.size();
+  std::vector<Vec3> first_vertex;
+  for (std::size_t f = 0; f < times.size(); ++f) {
+    vtkNew<vtkXMLPolyDataReader> reader;
+    reader->SetFileName((dir / ("vtk/walls_00000" + std::to_string(f) + ".vtp")).c_str());
+    reader->Update();
+    vtkPolyData* poly = reader->GetOutput();
+    REQUIRE(poly->GetNumberOfPoints() == static_cast<vtkIdType>(nm + 4));
+    REQUIRE(poly->GetNumberOfPolys() == static_cast<vtkIdType>(mantle.mesh.triangleCount() + 2));
+    vtkDataArray* wall = poly->GetCellData()->GetArray("wall");
+    REQUIRE(wall != nullptr);
+    CHECK(wall->GetComponent(0, 0) == 0);
+    CHECK(wall->GetComponent(poly->GetNumberOfPolys() - 1, 0) == 1);
+    const rocklab::sim::WallPose pose = rocklab::sim::wallPoseAt(mantle.motion, times[f]);
+    for (std::size_t k = 0; k < nm; k += 7) {
+      const Vec3 x(Eigen::Map<const Vec3>(poly->GetPoint(static_cast<vtkIdType>(k))));
+      CHECK((x - pose.place(mantle.mesh.vertices[k])).norm() < 1e-12);
+      vtkDataArray* velocity = poly->GetPointData()->GetArray("velocity");
+      CHECK((Vec3(Eigen::Map<const Vec3>(velocity->GetTuple3(static_cast<vtkIdType>(k)))) - pose.velocityAt(x)).norm() < 1e-9);
+    }
+    first_vertex.emplace_back(Eigen::Map<const Vec3>(poly->GetPoint(0)));
+    // The static gate stays where it is.
+    CHECK(Vec3(Eigen::Map<const Vec3>(poly->GetPoint(static_cast<vtkIdType>(nm)))) == gate.vertices[0]);
+  }
+  CHECK((first_vertex[1] - first_vertex[0]).norm() > 0.1);  // the mantle moved (1.57 rad about z)
 }

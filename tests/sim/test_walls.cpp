@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "support.h"
+#include "wall_runtime.h"
 
 using namespace rocklab;
 using test::Vec3;
@@ -137,4 +138,39 @@ TEST_CASE("a wall that appears later (active_from): passed through before, bounc
   // 2 %: the leapfrog's impact error at the automatic step (<= 1.3 %, tests/stability).
   CHECK(p.velocity[1].x() == Approx(-1.0).epsilon(0.02));
   CHECK(p.position[1].x() < -0.1);
+}
+
+TEST_CASE("a wall that only spins moves its material, not its surface: it drags a resting ball", "[walls]") {
+  // A square mesh floor spinning at 0.002 rad/s about a vertical axis 100 m away
+  // (WallMotion spin: a surface that maps onto itself, like the crusher's mantle):
+  // near the ball its material moves at -0.2 m/s along x, almost uniformly. The
+  // surface stays put (no neighbour rebuild, no pose), but the wall is not static:
+  // the ball is dragged to 2/7 of the belt speed as by a translating floor.
+  sim::Wall floor = test::floorPlane();
+  floor.shape = sim::WallShape::Mesh;
+  floor.mesh.vertices = {{-0.2, -0.2, 0}, {0.2, -0.2, 0}, {0.2, 0.2, 0}, {-0.2, 0.2, 0}};
+  floor.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  floor.motion.spin_rate = 0.002;
+  floor.motion.spin_axis = Vec3::UnitZ();
+  floor.motion.spin_point = Vec3(0, -100, 0);
+  REQUIRE(!floor.motion.isStatic());
+  REQUIRE(!floor.motion.surfaceMoves());
+
+  sim::detail::WallRuntime runtime;
+  runtime.setup(floor);
+  runtime.update(floor, 0.0);
+  runtime.setReference();
+  runtime.update(floor, 50.0);
+  CHECK(runtime.displacementSinceReference() == 0.0);
+  CHECK((runtime.velocityAt(Vec3(0, 0, 0)) - Vec3(-0.2, 0, 0)).norm() < 1e-12);
+  CHECK(runtime.velocityAt(Vec3(0, -100, 0.3)).norm() < 1e-12);  // on the spin axis
+
+  auto model = test::linearModel(2e7, 0.5, 0.3);
+  model.gravity = Vec3(0, 0, -9.81);
+  model.walls.push_back(floor);
+  sim::World w(model, {test::sphere({0, 0, 0.00999}, 0.01)}, 1);
+  while (w.time() < 0.3) w.step();
+  CHECK(w.particles().velocity[0].x() == Approx(2.0 / 7.0 * -0.2).epsilon(0.02));
+  CHECK(std::abs(w.particles().velocity[0].y()) < 1e-3);
+  CHECK(w.particles().position[0].z() == Approx(0.01).margin(2e-4));
 }

@@ -1,6 +1,7 @@
 #include "drivers/registry.h"
 
 #include "drivers/chute_experiment.h"
+#include "drivers/crusher_experiment.h"
 #include "drivers/drop_experiment.h"
 #include "drivers/heap_experiment.h"
 #include "drivers/zwick_experiment.h"
@@ -13,6 +14,7 @@ const std::vector<ExperimentDriver>& experimentDrivers() {
       {"heap", readHeapSettings, makeHeapExperiment},
       {"chute", readChuteSettings, makeChuteExperiment},
       {"zwick", readZwickSettings, makeZwickExperiment},
+      {"crusher", readCrusherRunSettings, makeCrusherRunExperiment},
   };
   return drivers;
 }

@@ -35,6 +35,7 @@ struct RunSetup {
   std::vector<std::unique_ptr<CameraRecorder>> cameras;
   std::unique_ptr<sim::output::RunFile> run_file;  // null without output.hdf5
   std::unique_ptr<sim::output::VtkSeries> vtk;     // null without output.vtk
+  std::unique_ptr<sim::output::VtkSeries> vtk_walls;  // the mesh and polygon walls beside it (null: none)
   // Space for results.json set aside at the start: a disk that fills up during
   // the run still takes the file that says the run failed.
   std::unique_ptr<sim::output::ReservedFile> results_file;

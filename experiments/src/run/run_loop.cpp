@@ -192,6 +192,7 @@ class RunLoop {
       if (frame_due_) setup_.run_file->writeFrame(s);
     }
     if (setup_.vtk && frame_due_) setup_.vtk->writeFrame(s);
+    if (setup_.vtk_walls && frame_due_) setup_.vtk_walls->writeWalls(world_->model(), s.time);
     if (frame_due_) ++record_.frames;
     record_.output_seconds += seconds(t0, Clock::now());
   }

@@ -197,7 +197,12 @@ int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, R
     if (scene.run.hdf5)
       setup.run_file = std::make_unique<out::RunFile>(options.out_dir / "run.h5", scene.text);
     if (scene.run.vtk)
+    {
       setup.vtk = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "particles");
+      const auto& walls = scene.model.walls;
+      if (std::any_of(walls.begin(), walls.end(), [](const sim::Wall& w) { return w.shape != sim::WallShape::Plane; }))
+        setup.vtk_walls = std::make_unique<out::VtkSeries>(options.out_dir / "vtk", "walls");
+    }
   } catch (const std::exception& e) {  // the folder was writable a moment ago: a full disk, a quota
     log << "error: cannot start the outputs in " << options.out_dir.string() << ": " << e.what() << "\n";
     return kExitFailed;

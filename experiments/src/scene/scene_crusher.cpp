@@ -1,7 +1,8 @@
 // Scene reader: [crusher], the cone crusher of experiments.md §g (Table 6.1 keys,
 // the readings of its ambiguities, the mantle speed and spin sense). The chamber
 // is derived and checked by geometry::coneCrusherGeometry; its walls are appended
-// to the model as static mesh walls.
+// to the model as mesh walls, the mantle and its cap moving (gyration + spin).
+#include "rocklab/geometry/frustum_mesh.h"
 #include "scene/scene_internal.h"
 
 namespace rocklab::experiments::detail {
@@ -37,17 +38,61 @@ geometry::SpinSense parseSpinSense(const std::string& v) {
 }
 
 void addWall(Scene& scene, int material, const std::string& name, const geometry::TriangleMesh& mesh,
-             const WallLook& look) {
+             const WallLook& look, const sim::WallMotion& motion = {}) {
   sim::Wall w;
   w.name = name;
   w.shape = sim::WallShape::Mesh;
   w.mesh = mesh;
   w.material = material;
+  w.motion = motion;
   scene.model.walls.push_back(std::move(w));
   scene.wall_looks.push_back(look);
 }
 
+/// §g.4's temporary walls: the feed-bin cylinder (wall 1) above the chamber and the
+/// flat stop wall (wall 2) the feed rests on until release_time, when it goes and
+/// the feed falls into the chamber.
+void addFeedWalls(TableReader& t, int material, const geometry::ConeCrusherGeometry& g, Scene& scene) {
+  const double top_of_chamber = g.O_top_c.y;
+  const double radius = t.number("feed_bin_radius", 0.07, Range::positive());
+  const double stop = t.number("stop_height", top_of_chamber + 0.01, Range::positive());
+  const double top = t.number("feed_bin_top", stop + 0.5, Range::positive());
+  const double release = t.number("release_time", 0.5, Range::positive());
+  if (!(radius < g.R_top_c))
+    t.fail("feed_bin_radius", "must be less than the upper concave's top radius R_top_c = " +
+                                  std::to_string(g.R_top_c * 1e3) + " mm (the feed must fall into the chamber)");
+  if (!(stop > top_of_chamber))
+    t.fail("stop_height", "must be above the chamber's top (O_top_c at " + std::to_string(top_of_chamber * 1e3) + " mm)");
+  if (!(top > stop)) t.fail("feed_bin_top", "must be above stop_height");
+  geometry::FrustumSpec bin;
+  bin.bottom_centre = geometry::Vec3(0, 0, stop);
+  bin.top_centre = geometry::Vec3(0, 0, top);
+  bin.bottom_radius = bin.top_radius = radius;
+  bin.segments = g.spec.segments;
+  bin.facing = geometry::FrustumFacing::TowardAxis;
+  addWall(scene, material, "crusher.feed_bin", geometry::frustumMesh(bin), WallLook{});
+  sim::Wall stop_wall;
+  stop_wall.name = "crusher.stop";
+  stop_wall.shape = sim::WallShape::Plane;
+  stop_wall.point = geometry::Vec3(0, 0, stop);
+  stop_wall.normal = geometry::Vec3::UnitZ();
+  stop_wall.material = material;
+  stop_wall.active_until = release;
+  scene.model.walls.push_back(stop_wall);
+  scene.wall_looks.push_back(WallLook{});
+}
+
 }  // namespace
+
+sim::WallMotion mantleWallMotion(const geometry::MantleMotion& m) {
+  sim::WallMotion w;
+  w.angular_velocity = geometry::Vec3(0, 0, m.eccentric_speed);  // the gyration G(t) about the crusher axis
+  w.pivot = geometry::Vec3::Zero();
+  w.spin_rate = m.signedSpin();  // Eq 6-9, velocity only: the mantle maps onto itself
+  w.spin_axis = m.axis;
+  w.spin_point = m.axis_point;
+  return w;
+}
 
 void readCrusher(TableReader& root, const std::map<std::string, int>& materials, Scene& scene) {
   auto t = root.table("crusher");
@@ -67,11 +112,13 @@ void readCrusher(TableReader& root, const std::map<std::string, int>& materials,
   if (walls) {
     const geometry::ConeCrusherMeshes m = geometry::coneCrusherMeshes(g);
     const WallLook look;
-    addWall(scene, c.material, "crusher.mantle", m.mantle, look);
-    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, look);
+    const sim::WallMotion mantle = mantleWallMotion(geometry::mantleMotion(g, c.eccentric_rpm, c.spin_sense));
+    addWall(scene, c.material, "crusher.mantle", m.mantle, look, mantle);
+    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, look, mantle);
     addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, look);
     addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, look);
   }
+  if (t->boolean("feed_bin", false)) addFeedWalls(*t, c.material, g, scene);
   scene.crusher = c;
   t->finish();
 }

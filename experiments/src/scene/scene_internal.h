@@ -45,6 +45,9 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
 /// [crusher]: the cone crusher's chamber and motion into scene.crusher, its
 /// walls appended to the model (scene_crusher.cpp).
 void readCrusher(TableReader& root, const std::map<std::string, int>& materials, Scene& scene);
+/// The mantle's (and its cap's) wall motion: the gyration as the rotation about
+/// the crusher axis, the spin of Eq 6-9 as WallMotion's spin (velocity only).
+sim::WallMotion mantleWallMotion(const geometry::MantleMotion& m);
 void readParticles(TableReader& root, const std::map<std::string, int>& materials,
                    const std::vector<sim::Material>& material_list, std::uint64_t seed,
                    const std::filesystem::path& base_dir, Scene& scene);

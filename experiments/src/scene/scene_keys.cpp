@@ -97,7 +97,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"relaxation", "steps", "", "Steps over which the initial overlaps are relaxed; 0 = off."},
 
       // --- [crusher]
-      {"crusher", "", "", "Cone crusher of experiments.md §g (Table 6.1; the baseline by default). Adds its walls as static mesh walls crusher.mantle, .mantle_cap, .lower_concave, .upper_concave; `rocklab crusher-geometry SCENE` prints the derived chamber (docs/crusher.md)."},
+      {"crusher", "", "", "Cone crusher of experiments.md §g (Table 6.1; the baseline by default). Adds its walls as mesh walls crusher.mantle and .mantle_cap (gyrating about the crusher axis and spinning by Eq 6-9), .lower_concave, .upper_concave (static); `rocklab crusher-geometry SCENE` prints the derived chamber (docs/crusher.md)."},
       {"crusher", "feed_opening", "m", "F: width of the chamber's feed opening; must exceed css."},
       {"crusher", "css", "m", "CSS: closed-side setting, the nominal smallest mantle-concave gap; below feed_opening."},
       {"crusher", "throw", "m", "s: eccentric travel of the cone in half a revolution."},
@@ -113,6 +113,11 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"crusher", "spin_sense", "", "Spin of the mantle about its own axis: opposite to the gyration (rolls on the feed at the closed side), same, or none."},
       {"crusher", "material", "", "Material of the crusher walls.", "a name under [materials]"},
       {"crusher", "walls", "", "Add the chamber walls (mantle, cap, lower and upper concave) to the scene's walls."},
+      {"crusher", "feed_bin", "", "Add §g.4's temporary walls: the feed-bin cylinder crusher.feed_bin above the chamber and the flat stop wall crusher.stop the feed rests on until release_time."},
+      {"crusher", "feed_bin_radius", "m", "Radius of the feed-bin cylinder (below R_top_c, so the feed falls into the chamber)."},
+      {"crusher", "stop_height", "m", "Height of the stop wall and the feed bin's bottom (above the chamber's top).", nullptr, "10 mm above O_top_c"},
+      {"crusher", "feed_bin_top", "m", "Height of the feed bin's top.", nullptr, "stop_height + 0.5 m"},
+      {"crusher", "release_time", "s", "When the stop wall goes and the feed falls into the chamber."},
 
       // --- [[walls]]
       {"walls", "", "", "A wall: plane, polygon, plate, mesh or box, with prescribed motion and an active time window. Keys by type are marked (plane), (polygon), ..."},
@@ -271,6 +276,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.chute", "jam_time", "s", "No discharge for this long while bodies remain = jammed; the run stops."},
       {"experiment.chute", "track", "", "Track the markers in the frames of track_camera."},
       {"experiment.chute", "track_camera", "", "Camera whose frames are tracked.", "a camera name", "the first camera"},
+      {"experiment.crusher", "", "", "type = \"crusher\": the cone crusher's run (docs/crusher.md): spheres below discharge_height are product (removed, size and mass in product.csv); ends when the chamber is empty."},
+      {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
+      {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
       {"experiment.zwick", "top_platen", "", "Plane wall that closes on the specimen.", "a plane wall name"},
@@ -292,7 +300,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"output", "energy_interval", "s", "Time between energy-log rows; 0 = at frames only."},
       {"output", "checkpoint_interval", "s", "Time between checkpoints; 0 = at the end only."},
       {"output", "hdf5", "", "Write run.h5."},
-      {"output", "vtk", "", "Write a ParaView series vtk/particles_*.vtp and particles.pvd."},
+      {"output", "vtk", "", "Write a ParaView series vtk/particles_*.vtp and particles.pvd, and (mesh or polygon walls) vtk/walls_*.vtp and walls.pvd at the walls' poses."},
       {"output", "checkpoint", "", "Write checkpoint.h5 (rocklab restart)."},
   };
   return docs;

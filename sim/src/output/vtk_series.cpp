@@ -1,6 +1,8 @@
 #include "rocklab/sim/output/vtk_series.h"
 
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkIntArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -25,6 +27,7 @@
 
 #include "rocklab/sim/output/file_write.h"
 #include "rocklab/sim/particles.h"  // sim::Vec3
+#include "rocklab/sim/wall_motion.h"
 #include "snapshot_check.h"
 
 namespace rocklab::sim::output {
@@ -83,6 +86,45 @@ vtkSmartPointer<vtkPolyData> makePolyData(const Snapshot& snapshot) {
   data->AddArray(vectorArray("omega", snapshot.omega));        // rad/s
   data->AddArray(vectorArray("force", snapshot.force));        // N
   data->AddArray(idArray(snapshot.id));
+  return poly;
+}
+
+/// The walls with an extent (meshes, polygons as a fan) active at `time`, each
+/// vertex where the wall's motion puts it then.
+vtkSmartPointer<vtkPolyData> makeWallPolyData(const Model& model, double time) {
+  std::vector<Vec3> positions, velocities;
+  vtkNew<vtkCellArray> triangles;
+  auto wall_index = vtkSmartPointer<vtkIntArray>::New();
+  wall_index->SetName("wall");
+  for (std::size_t k = 0; k < model.walls.size(); ++k) {
+    const Wall& w = model.walls[k];
+    if (w.shape == WallShape::Plane || !w.activeAt(time)) continue;
+    const WallPose pose = wallPoseAt(w.motion, time);
+    const auto first = static_cast<vtkIdType>(positions.size());
+    const std::vector<Vec3>& rest = w.shape == WallShape::Mesh ? w.mesh.vertices : w.vertices;
+    for (const Vec3& v : rest) {
+      positions.push_back(pose.place(v));
+      velocities.push_back(w.motion.isStatic() ? Vec3::Zero() : pose.velocityAt(positions.back()));
+    }
+    auto add = [&](vtkIdType a, vtkIdType b, vtkIdType c) {
+      const vtkIdType ids[3] = {first + a, first + b, first + c};
+      triangles->InsertNextCell(3, ids);
+      wall_index->InsertNextValue(static_cast<int>(k));
+    };
+    if (w.shape == WallShape::Mesh) {
+      for (const auto& t : w.mesh.triangles) add(t[0], t[1], t[2]);
+    } else {
+      for (std::size_t j = 1; j + 1 < rest.size(); ++j)
+        add(0, static_cast<vtkIdType>(j), static_cast<vtkIdType>(j + 1));  // convex: a fan
+    }
+  }
+  vtkNew<vtkPoints> points;
+  points->SetData(vectorArray("position", positions));
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  poly->SetPolys(triangles);
+  poly->GetCellData()->SetScalars(wall_index);
+  poly->GetPointData()->AddArray(vectorArray("velocity", velocities));  // m/s
   return poly;
 }
 
@@ -163,13 +205,21 @@ VtkSeries::VtkSeries(std::filesystem::path directory, std::string basename)
   std::filesystem::create_directories(directory_);
 }
 
+void VtkSeries::addFrame(double time, const std::function<void(const std::filesystem::path&)>& write) {
+  const std::string name = frameFileName(basename_, entries_.size());
+  writeAtomically(directory_ / name, write);
+  entries_.emplace_back(time, name);
+  writeCollection();  // the .pvd always lists every finished frame
+}
+
 void VtkSeries::writeFrame(const Snapshot& snapshot) {
   const vtkSmartPointer<vtkPolyData> poly = makePolyData(snapshot);
-  const std::string name = frameFileName(basename_, entries_.size());
-  writeAtomically(directory_ / name,
-                  [&](const std::filesystem::path& file) { writePolyData(poly, file); });
-  entries_.emplace_back(snapshot.time, name);
-  writeCollection();  // the .pvd always lists every finished frame
+  addFrame(snapshot.time, [&](const std::filesystem::path& file) { writePolyData(poly, file); });
+}
+
+void VtkSeries::writeWalls(const Model& model, double time) {
+  const vtkSmartPointer<vtkPolyData> poly = makeWallPolyData(model, time);
+  addFrame(time, [&](const std::filesystem::path& file) { writePolyData(poly, file); });
 }
 
 void VtkSeries::writeCollection() const {

@@ -57,7 +57,7 @@ void World::Impl::rebuildNeighbours() {
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t k = 0; k < walls.size(); ++k) {
       if (!walls[k].active) continue;
-      if (walls[k].distance(model.walls[k], p.position[i]) < p.radius[i] + nb.skin)
+      if (walls[k].within(model.walls[k], p.position[i], p.radius[i] + nb.skin))
         nb.wall_index.push_back(static_cast<std::uint32_t>(k));
     }
     nb.wall_offset[i + 1] = static_cast<std::uint32_t>(nb.wall_index.size());

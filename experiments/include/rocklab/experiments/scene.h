@@ -110,9 +110,10 @@ struct WallLook {
 
 /// The cone crusher of a scene ([crusher], experiments.md §g): its chamber
 /// (geometry/cone_crusher.h) and mantle motion (geometry/mantle_motion.h). Its
-/// walls are added to the model as static mesh walls named crusher.mantle,
-/// crusher.mantle_cap, crusher.lower_concave, crusher.upper_concave: the engine
-/// cannot move the mantle yet (the spin is not a WallMotion; docs/crusher.md).
+/// walls are added to the model as mesh walls named crusher.mantle,
+/// crusher.mantle_cap (both gyrating about the crusher axis and spinning by Eq
+/// 6-9: the spin is a WallMotion spin, velocity only), crusher.lower_concave,
+/// crusher.upper_concave (static).
 struct CrusherSettings {
   geometry::ConeCrusherSpec spec;
   double eccentric_rpm = 300.0;  // rpm, gyration speed (omega_ecc)

@@ -43,14 +43,29 @@ struct ContactModel {
 /// Prescribed motion of a wall: x(t) = pivot + T(t) + R(t) (x0 - pivot), with
 /// T(t) = velocity t + amplitude sin(2 pi frequency t) and R(t) the rotation by
 /// angular_velocity t about the pivot.
+///
+/// A spin about a body axis (spin_rate about spin_axis through spin_point, both in
+/// the rest frame) moves the wall's material but not its surface: it is for a
+/// surface of revolution about that axis (the cone crusher's mantle, Eq 6-9),
+/// which the spin maps onto itself. It enters only the wall velocity,
+///   v(x) = dT/dt + omega x (x - pivot - T) + spin_rate (R a) x (x - x_a),
+///   x_a = pivot + T + R (spin_point - pivot),
+/// never the pose: turning the mesh would make its tessellation wobble and force
+/// neighbour rebuilds for a surface that does not move.
 struct WallMotion {
   geometry::Vec3 velocity = geometry::Vec3::Zero();          // m/s
   geometry::Vec3 angular_velocity = geometry::Vec3::Zero();  // rad/s
   geometry::Vec3 pivot = geometry::Vec3::Zero();             // m
   geometry::Vec3 amplitude = geometry::Vec3::Zero();         // m, oscillation
   double frequency = 0.0;                                    // Hz, oscillation
-  bool isStatic() const {
-    return velocity.isZero(0) && angular_velocity.isZero(0) && (amplitude.isZero(0) || frequency == 0.0);
+  double spin_rate = 0.0;                                    // rad/s, signed, about spin_axis
+  geometry::Vec3 spin_axis = geometry::Vec3::UnitZ();        // unit, rest frame
+  geometry::Vec3 spin_point = geometry::Vec3::Zero();        // m, on the spin axis, rest frame
+  /// A wall whose material does not move (a spinning wall moves: it does work).
+  bool isStatic() const { return !surfaceMoves() && spin_rate == 0.0; }
+  /// Whether the surface moves (a spin alone leaves it where it is).
+  bool surfaceMoves() const {
+    return !(velocity.isZero(0) && angular_velocity.isZero(0) && (amplitude.isZero(0) || frequency == 0.0));
   }
 };
 

@@ -5,12 +5,17 @@
 //
 //   x(t) = pivot + T(t) + R(t) (x0 - pivot),   T(t) = v t + A sin(2 pi f t),
 //   R(t) = rotation by |omega| t about omega  (x0: a point of the wall at rest)
+//
+// R(t) is built from the angle reduced to one turn (geometry::turnAngle), so the
+// pose after any number of whole turns is the pose at t = 0 to round-off. A spin
+// (WallMotion::spin_rate) adds to the velocity only (model.h says why).
 #include <cmath>
 #include <algorithm>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "rocklab/geometry/mantle_motion.h"  // turnAngle
 #include "rocklab/sim/model.h"
 
 namespace rocklab::sim {
@@ -20,11 +25,20 @@ struct WallPose {
   geometry::Vec3 velocity = geometry::Vec3::Zero();     // m/s, dT/dt
   geometry::Vec3 omega = geometry::Vec3::Zero();        // rad/s
   geometry::Vec3 pivot = geometry::Vec3::Zero();        // m, at rest
-  double angle = 0.0;                                   // rad turned since t = 0
+  double angle = 0.0;                                   // rad turned since t = 0 (not reduced)
   geometry::Mat3 rotation = geometry::Mat3::Identity(); // R(t)
+  double spin_rate = 0.0;                               // rad/s, about spin_axis
+  geometry::Vec3 spin_axis = geometry::Vec3::UnitZ();   // unit, world frame at t: R a0
+  geometry::Vec3 spin_point = geometry::Vec3::Zero();   // m, world frame at t: x_a
 
   /// Where the rest point x0 of the wall is at this pose.
   geometry::Vec3 place(const geometry::Vec3& x0) const { return pivot + translation + rotation * (x0 - pivot); }
+  /// Velocity of the wall material at world point x (the spin included).
+  geometry::Vec3 velocityAt(const geometry::Vec3& x) const {
+    geometry::Vec3 v = velocity + omega.cross(x - (pivot + translation));
+    if (spin_rate != 0.0) v += spin_rate * spin_axis.cross(x - spin_point);
+    return v;
+  }
 };
 
 inline WallPose wallPoseAt(const WallMotion& m, double t) {
@@ -35,8 +49,12 @@ inline WallPose wallPoseAt(const WallMotion& m, double t) {
   p.omega = m.angular_velocity;
   p.pivot = m.pivot;
   p.angle = p.omega.norm() * t;
-  p.rotation = p.angle > 0 ? geometry::Mat3(Eigen::AngleAxisd(p.angle, p.omega.normalized()).toRotationMatrix())
-                           : geometry::Mat3::Identity();
+  const double turned = geometry::turnAngle(p.omega.norm(), t);
+  p.rotation = turned > 0 ? geometry::Mat3(Eigen::AngleAxisd(turned, p.omega.normalized()).toRotationMatrix())
+                          : geometry::Mat3::Identity();
+  p.spin_rate = m.spin_rate;
+  if (p.spin_rate != 0.0) p.spin_axis = p.rotation * m.spin_axis.normalized();
+  p.spin_point = p.place(m.spin_point);
   return p;
 }
 

@@ -1,0 +1,57 @@
+#pragma once
+// Closest points on a triangle mesh through a spatial index: CGAL's AABB tree
+// over the mesh's triangles (with its search tree for distance queries), built
+// once. A mesh wall asks this for every ball near it on every step; the brute
+// force of TriangleMesh::closestPoint visits every triangle (the cone crusher's
+// walls have 96-192 each, an imported wall thousands).
+//
+// The tree finds the nearest triangle; the point on it is computed by the same
+// closestPointOnTriangle as the brute force, so both give the same point up to
+// round-off (a tie between triangles sharing an edge or vertex is the same point).
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "rocklab/geometry/triangle_mesh.h"
+
+namespace rocklab::geometry {
+
+class TriangleMeshIndex {
+ public:
+  TriangleMeshIndex() = default;  // no mesh: closestPoint must not be called
+  /// Copies what it needs of `mesh` (which must pass validate()).
+  explicit TriangleMeshIndex(const TriangleMesh& mesh);
+
+  bool empty() const { return !tree_; }
+  /// Closest point on the mesh surface to p.
+  Vec3 closestPoint(const Vec3& p) const;
+  /// Index (into mesh.triangles) of a triangle holding that point.
+  std::size_t closestTriangle(const Vec3& p) const;
+  /// The closest point on the mesh if it is nearer to p than `radius` (false
+  /// otherwise): only the triangles whose boxes meet p's box are visited, and the
+  /// point is the brute force's (the first triangle in mesh order on a tie), so a
+  /// ball's contact costs a few triangles whatever the mesh.
+  bool closestPointWithin(const Vec3& p, double radius, Vec3& closest) const;
+
+  /// A point where a ball centred at p touches the surface.
+  struct Touch {
+    Vec3 point;               // closest point on `triangle`
+    std::size_t triangle = 0;
+    double distance = 0;      // m, |p - point|
+  };
+  /// Every place where a ball (centre p, radius r) touches the mesh, once each:
+  /// the local minima of the distance from p over the surface closer than r. A
+  /// point on a triangle's face is one; a point on an edge or a vertex is one only
+  /// when no triangle sharing that edge or vertex comes closer (else it is the
+  /// same contact seen from a neighbour: a flat mesh split into triangles, a
+  /// convex ridge or a cone's apex give one touch), and touches at the same point
+  /// are merged. A ball in a concave crease touching both faces gets two.
+  /// Sorted by distance, then triangle.
+  std::vector<Touch> touches(const Vec3& p, double r) const;
+
+ private:
+  struct Tree;
+  std::shared_ptr<const Tree> tree_;  // shared: copies of an index (and of a wall) share one tree
+};
+
+}  // namespace rocklab::geometry
