@@ -148,7 +148,7 @@ TEST_CASE("study --seeds: each variant runs once per seed and the table gives me
                "--plan", dir.string()}) == 0);
   const auto run_lines = lines(dir / "runs.txt");
   REQUIRE(run_lines.size() == 6);  // 2 variants x 3 seeds, the seed fastest, from the scene's seed (1) up
-  for (int k = 0; k < 6; ++k) CHECK(run_lines[k].find("scene.seed=" + std::to_string(1 + k % 3) + "'") != std::string::npos);
+  for (int k = 0; k < 6; ++k) CHECK(run_lines[k].find("--set scene.seed=" + std::to_string(1 + k % 3) + " ") != std::string::npos);
   CHECK(cli({"study", "drop", "--vary", "scene.seed=1,2", "--figure", "restitution", "--seeds", "2", "--plan",
              (dir / "both").string()}) == 2);
   // Stand-ins for six finished runs (the figures chosen so that the statistics are known):
