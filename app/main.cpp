@@ -1,4 +1,6 @@
 // rocklab executable: all logic lives in rocklab_experiments (testable in-process).
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -8,6 +10,9 @@
 
 namespace {
 
+/// The OpenMP wait policy rocklab runs with unless the user sets one (see below).
+constexpr const char* kWaitPolicy = "passive";
+
 /// runCli catches every exception of a command; this is for what escapes even that
 /// (a throw from a destructor or a noexcept function): one line and exit code 1
 /// ("failed") instead of abort()'s core dump and 134.
@@ -16,9 +21,24 @@ namespace {
   std::_Exit(rocklab::experiments::kExitFailed);
 }
 
+/// OpenMP threads that wait at a barrier spin by default (libgomp: ~300,000 turns) before
+/// they sleep. On a core that another process holds, the spinning thread takes the time
+/// the working one needs: a 16,000-ball settle of 2,000 steps took 18.6-29.7 s on two
+/// threads beside a busy process, against 2.9-3.7 s on one, and 2.0-2.7 s on two threads
+/// that sleep at once (OMP_WAIT_POLICY=passive; docs/performance.md). libgomp reads the
+/// policy once when it is loaded, before main, so when the user has set neither
+/// OMP_WAIT_POLICY nor GOMP_SPINCOUNT the process sets it and starts itself again (same
+/// pid, arguments and files); a user's own setting is kept as it is.
+void chooseOpenMpWaitPolicy(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
+  if (::setenv("OMP_WAIT_POLICY", kWaitPolicy, 1) != 0) return;
+  ::execv("/proc/self/exe", argv);  // returns only if it failed: go on with the default
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  chooseOpenMpWaitPolicy(argv);
   std::set_terminate(onTerminate);
   return rocklab::experiments::runCli(argc, argv);
 }

@@ -203,3 +203,19 @@ TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and say
   CHECK(std::signal(SIGTERM, before) == before);
   fs::remove_all(dir);
 }
+
+TEST_CASE("the rocklab executable runs its threads with a passive OpenMP wait unless the user chose", "[cli]") {
+  // Spinning waiters take a shared core from the working thread (app/main.cpp); the
+  // executable sets OMP_WAIT_POLICY=passive for itself, and keeps a user's own choice.
+  const std::string exe = (fs::path(ROCKLAB_BINARY_DIR) / "app" / "rocklab").string();
+  const fs::path dir = fresh("wait");
+  const std::string run = exe + " run drop --quiet --threads 2 --set scene.end_time=0.001 --overwrite --out ";
+  REQUIRE(shell("env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT " + run + (dir / "own").string()) == 0);
+  REQUIRE(shell("env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=active " + run + (dir / "user").string()) == 0);
+  const auto waitOf = [&](const char* name) {
+    return nlohmann::json::parse(rocklab::experiments::test::slurp(dir / name / "results.json"))["openmp_wait"];
+  };
+  CHECK(waitOf("own") == "OMP_WAIT_POLICY=passive");
+  CHECK(waitOf("user") == "OMP_WAIT_POLICY=active");
+  fs::remove_all(dir);
+}

@@ -1,5 +1,6 @@
 // Results of a run (run_internal.h): results.json, the cameras' and the
 // experiment's reports, and the closing log lines.
+#include <cstdlib>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -125,6 +126,12 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["walls"] = world.model().walls.size();
   r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
   r["threads"] = world.threads();
+  // How waiting OpenMP threads behave (app/main.cpp sets "passive" unless the user chose).
+  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
+  const char* spin_count = std::getenv("GOMP_SPINCOUNT");
+  r["openmp_wait"] = wait_policy ? std::string("OMP_WAIT_POLICY=") + wait_policy
+                     : spin_count ? std::string("GOMP_SPINCOUNT=") + spin_count
+                                  : std::string("libgomp default");
   r["modules"] = setup.modules;
   r["seed"] = scene.run.seed;
   r["settings"] = settingsJson(scene);
