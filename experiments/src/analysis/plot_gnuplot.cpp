@@ -86,7 +86,9 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
        number(yr.hi) + "]\n";
   if (spec.log_x) s += "set logscale x\n";
   if (spec.log_y) s += "set logscale y\n";
-  s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\nset key box opaque\n";
+  s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\n"
+       // The key above the axes: inside them an opaque key hid the data points under it.
+       "set key outside top center horizontal box\n";
   const std::string size = std::to_string(spec.width) + "," + std::to_string(spec.height);
   s += "set terminal pngcairo noenhanced size " + size + " background rgb 'white' font 'sans,10'\nset output " +
        quoted(png_partial.string()) + "\n" + plot + "\n";
