@@ -1,5 +1,6 @@
 // writePlot's gnuplot drawing (plot_internal.h): one script (data inline), run as
 // a child process; PNG by pngcairo and SVG from the same plot.
+#include <algorithm>
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -86,9 +87,12 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
        number(yr.hi) + "]\n";
   if (spec.log_x) s += "set logscale x\n";
   if (spec.log_y) s += "set logscale y\n";
-  s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\n"
-       // The key above the axes: inside them an opaque key hid the data points under it.
-       "set key outside top center horizontal box\n";
+  s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\n";
+  // The key above the axes (inside them an opaque key hid the data points under it);
+  // none when no series has a label (an empty box otherwise).
+  s += (std::any_of(spec.series.begin(), spec.series.end(), [](const PlotSeries& p) { return !p.label.empty(); })
+            ? "set key outside top center horizontal box\n"
+            : "unset key\n");
   const std::string size = std::to_string(spec.width) + "," + std::to_string(spec.height);
   s += "set terminal pngcairo noenhanced size " + size + " background rgb 'white' font 'sans,10'\nset output " +
        quoted(png_partial.string()) + "\n" + plot + "\n";
