@@ -176,7 +176,7 @@ TEST_CASE("a wall that only spins moves its material, not its surface: it drags 
   CHECK(w.particles().position[0].z() == Approx(0.01).margin(2e-4));
 }
 
-TEST_CASE("a spinning faceted frustum: the contact velocity has no spin normal part, its tangential part is omega x r",
+TEST_CASE("a spinning faceted frustum wall: the contact velocity has no spin normal part, its tangential part is omega x r",
           "[walls][motion]") {
   // A coarse (12-facet) mantle spinning about its axis and translating: on a facet
   // off its middle omega x r leans into the facet (the true surface of revolution
