@@ -109,6 +109,12 @@ class WallRuntime {
     if (!moves_material_) return Vec3::Zero();
     return pose_.velocityAt(x);
   }
+  /// Velocity of the wall material at a contact at x with unit normal n: the
+  /// spin's normal part removed (WallPose::contactVelocityAt says why).
+  Vec3 contactVelocityAt(const Vec3& x, const Vec3& n) const {
+    if (!moves_material_) return Vec3::Zero();
+    return pose_.contactVelocityAt(x, n);
+  }
 
  private:
   Vec3 toBody(const Vec3& x) const {

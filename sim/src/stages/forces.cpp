@@ -91,7 +91,7 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
       }
     }
     const Vec3 ai = cp - xi;
-    const Vec3 v_wall = wr.velocityAt(cp);
+    const Vec3 v_wall = wr.contactVelocityAt(cp, g.normal);  // the spin: tangential only
     g.rel_velocity = v_wall - (p.velocity[i] + p.omega[i].cross(ai));
     g.r_tilde = ri;            // mirror-image ball (ref §4.2)
     g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)

@@ -51,7 +51,10 @@ struct ContactModel {
 ///   v(x) = dT/dt + omega x (x - pivot - T) + spin_rate (R a) x (x - x_a),
 ///   x_a = pivot + T + R (spin_point - pivot),
 /// never the pose: turning the mesh would make its tessellation wobble and force
-/// neighbour rebuilds for a surface that does not move.
+/// neighbour rebuilds for a surface that does not move. At a contact only the
+/// spin's tangential part counts (WallPose::contactVelocityAt): on the true
+/// surface of revolution it has no other, on its facets the normal part is an
+/// artefact the overlap never sees.
 struct WallMotion {
   geometry::Vec3 velocity = geometry::Vec3::Zero();          // m/s
   geometry::Vec3 angular_velocity = geometry::Vec3::Zero();  // rad/s

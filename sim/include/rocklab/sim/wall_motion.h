@@ -34,10 +34,28 @@ struct WallPose {
   /// Where the rest point x0 of the wall is at this pose.
   geometry::Vec3 place(const geometry::Vec3& x0) const { return pivot + translation + rotation * (x0 - pivot); }
   /// Velocity of the wall material at world point x (the spin included).
-  geometry::Vec3 velocityAt(const geometry::Vec3& x) const {
-    geometry::Vec3 v = velocity + omega.cross(x - (pivot + translation));
-    if (spin_rate != 0.0) v += spin_rate * spin_axis.cross(x - spin_point);
-    return v;
+  geometry::Vec3 velocityAt(const geometry::Vec3& x) const { return surfaceVelocityAt(x) + spinVelocityAt(x); }
+  /// Velocity of the moving surface (translation and rotation) at world point x.
+  geometry::Vec3 surfaceVelocityAt(const geometry::Vec3& x) const {
+    return velocity + omega.cross(x - (pivot + translation));
+  }
+  /// Velocity the spin alone gives the material at world point x.
+  geometry::Vec3 spinVelocityAt(const geometry::Vec3& x) const {
+    if (spin_rate == 0.0) return geometry::Vec3::Zero();
+    return spin_rate * spin_axis.cross(x - spin_point);
+  }
+  /// Velocity of the wall material at a contact at x with unit normal n (either
+  /// sense): the surface's motion in full, the spin's tangential part only. The
+  /// spin maps the true surface (a surface of revolution) onto itself, so its
+  /// velocity there is tangential; on the faceted mesh that stands for it, omega x r
+  /// has a normal part (up to |omega| R sin(pi / segments) at a facet's edge) that
+  /// the overlap never sees, as the pose does not spin. Left in, it drives the
+  /// normal dashpot and enters the wall work F . v: on a ball pinched between the
+  /// mantle and the concave the spurious power F_n v_n grows with the pinch force
+  /// (docs/crusher.md: the PBM run's energy watchdog).
+  geometry::Vec3 contactVelocityAt(const geometry::Vec3& x, const geometry::Vec3& n) const {
+    const geometry::Vec3 spin = spinVelocityAt(x);
+    return surfaceVelocityAt(x) + (spin - spin.dot(n) * n);
   }
 };
 
