@@ -10,8 +10,9 @@
 
 namespace {
 
-/// The OpenMP wait policy rocklab runs with unless the user sets one (see below).
-constexpr const char* kWaitPolicy = "passive";
+/// How long a waiting OpenMP thread spins before it sleeps, unless the user sets it
+/// (see below): 1000 turns, a few microseconds.
+constexpr const char* kSpinCount = "1000";
 
 /// runCli catches every exception of a command; this is for what escapes even that
 /// (a throw from a destructor or a noexcept function): one line and exit code 1
@@ -24,14 +25,15 @@ constexpr const char* kWaitPolicy = "passive";
 /// OpenMP threads that wait at a barrier spin by default (libgomp: ~300,000 turns) before
 /// they sleep. On a core that another process holds, the spinning thread takes the time
 /// the working one needs: a 16,000-ball settle of 2,000 steps took 18.6-29.7 s on two
-/// threads beside a busy process, against 2.9-3.7 s on one, and 2.0-2.7 s on two threads
-/// that sleep at once (OMP_WAIT_POLICY=passive; docs/performance.md). libgomp reads the
-/// policy once when it is loaded, before main, so when the user has set neither
+/// threads beside a busy process, against 2.9-3.7 s on one. Sleeping at once (passive)
+/// costs 29 % on an idle machine; 1000 turns cost nothing measurable idle and keep two
+/// threads as fast as one under load (docs/performance.md). libgomp reads the setting
+/// once when it is loaded, before main, so when the user has set neither
 /// OMP_WAIT_POLICY nor GOMP_SPINCOUNT the process sets it and starts itself again (same
 /// pid, arguments and files); a user's own setting is kept as it is.
 void chooseOpenMpWaitPolicy(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
-  if (::setenv("OMP_WAIT_POLICY", kWaitPolicy, 1) != 0) return;
+  if (::setenv("GOMP_SPINCOUNT", kSpinCount, 1) != 0) return;
   ::execv("/proc/self/exe", argv);  // returns only if it failed: go on with the default
 }
 

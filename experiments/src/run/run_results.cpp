@@ -126,7 +126,7 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["walls"] = world.model().walls.size();
   r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
   r["threads"] = world.threads();
-  // How waiting OpenMP threads behave (app/main.cpp sets "passive" unless the user chose).
+  // How waiting OpenMP threads behave (app/main.cpp sets a short spin unless the user chose).
   const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
   const char* spin_count = std::getenv("GOMP_SPINCOUNT");
   r["openmp_wait"] = wait_policy ? std::string("OMP_WAIT_POLICY=") + wait_policy
