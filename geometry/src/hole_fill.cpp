@@ -7,6 +7,8 @@
 #include <iterator>
 #include <map>
 
+#include "mesh_edges.h"
+
 namespace rocklab::geometry::detail {
 
 namespace {
@@ -17,18 +19,18 @@ using Tri = std::array<std::uint32_t, 3>;
 HoleFill fillSmallHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& triangles, std::size_t max_edges) {
   HoleFill out;
   if (max_edges < 3) return out;
-  // Directed edges of the triangles; a boundary edge a -> b has no b -> a partner.
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  for (const Tri& t : triangles)
-    for (int e = 0; e < 3; ++e) ++uses[{std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])}];
-  // The boundary runs b -> a around the hole when the surface runs a -> b; the patch
-  // must run the way the surface does across the shared edge: b -> a is its edge.
+  // A boundary edge is used by one triangle. The hole loop runs b -> a where that
+  // triangle runs a -> b: the patch must run the way the surface does across it.
   std::multimap<std::uint32_t, std::uint32_t> next;  // hole loop: from -> to (against the surface)
-  for (const Tri& t : triangles)
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
-      if (uses[{std::min(a, b), std::max(a, b)}] == 1) next.emplace(b, a);
-    }
+  const std::vector<EdgeUse> uses = edgeUses(triangles);
+  for (std::size_t i = 0; i < uses.size(); ++i) {
+    if ((i > 0 && uses[i - 1].key == uses[i].key) || (i + 1 < uses.size() && uses[i + 1].key == uses[i].key)) continue;
+    const auto lo = static_cast<std::uint32_t>(uses[i].key >> 32), hi = static_cast<std::uint32_t>(uses[i].key);
+    if (uses[i].forward)
+      next.emplace(hi, lo);  // the triangle runs lo -> hi
+    else
+      next.emplace(lo, hi);
+  }
   std::map<std::uint32_t, bool> used;
   for (const auto& [start, first] : next) {
     if (used[start] || next.count(start) != 1) continue;

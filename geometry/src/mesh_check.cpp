@@ -14,6 +14,7 @@
 
 #include "assimp_mesh.h"
 #include "hole_fill.h"
+#include "mesh_edges.h"
 #include "rocklab/geometry/mesh_file_check.h"
 
 namespace rocklab::geometry {
@@ -22,28 +23,8 @@ namespace {
 
 using Tri = std::array<std::uint32_t, 3>;
 
-// One use of an undirected edge by a triangle; `forward` when the triangle runs
-// lo → hi along it.
-struct EdgeUse {
-  std::uint64_t key;
-  std::uint32_t triangle;
-  bool forward;
-};
-
-std::vector<EdgeUse> edgeUses(const std::vector<Tri>& tris) {
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * tris.size());
-  for (std::uint32_t t = 0; t < tris.size(); ++t)
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = tris[t][e], b = tris[t][(e + 1) % 3];
-      const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
-      uses.push_back({(std::uint64_t{lo} << 32) | hi, t, a == lo});
-    }
-  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
-    return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
-  });
-  return uses;
-}
+using detail::EdgeUse;
+using detail::edgeUses;
 
 /// Edges a message names (where to look in the scan), at most.
 constexpr std::size_t kEdgesNamed = 3;
