@@ -439,7 +439,7 @@ int calibrateBondsCommand(const CliArgs& a) {
 
 /// True (and says so) when DIR holds the results.json of a completed run.
 bool isCompleteRun(const std::filesystem::path& dir) {
-  if (detail::resultStatus(detail::readJsonFile(dir / "results.json")) != "completed") return false;
+  if (!detail::runCompleted(dir)) return false;
   std::cerr << "rocklab: " << (dir / "results.json").string() << " is complete; not run again\n";
   return true;
 }

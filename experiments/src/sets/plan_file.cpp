@@ -87,6 +87,10 @@ std::string resultStatus(const json& results) {
   return it != results.end() && it->is_string() ? it->get<std::string>() : "";
 }
 
+bool runCompleted(const std::filesystem::path& dir) {
+  return resultStatus(readJsonFile(dir / "results.json")) == "completed";
+}
+
 PlanFile readPlanFile(const std::filesystem::path& dir) {
   const std::filesystem::path path = dir / "plan.json";
   const std::string file = path.string();

@@ -31,4 +31,7 @@ PlanFile readPlanFile(const std::filesystem::path& dir);
 /// results.json's "status" when it is a string, else "" (a damaged file is no run).
 std::string resultStatus(const nlohmann::json& results);
 
+/// True when the run folder `dir` holds the results.json of a completed run.
+bool runCompleted(const std::filesystem::path& dir);
+
 }  // namespace rocklab::experiments::detail

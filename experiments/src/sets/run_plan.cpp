@@ -80,10 +80,6 @@ fs::path selfExecutable() {
   return self;
 }
 
-bool complete(const fs::path& results) {
-  return resultStatus(readJsonFile(results)) == "completed";
-}
-
 /// What went wrong, from a run's log: its last "error..." line (the watchdog's or the
 /// scene reader's message), else its last "rocklab: stopped/interrupted" line, else its
 /// last line.
@@ -276,7 +272,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
   std::vector<const PlannedRun*> todo;
   std::size_t skipped = 0;
   for (const PlannedRun& r : runs) {
-    if (complete(set_dir / "runs" / r.name / "results.json")) {
+    if (runCompleted(set_dir / "runs" / r.name)) {
       ++skipped;
     } else if (!r.invalid.empty()) {
       writeAtomically(set_dir / "logs" / (r.name + ".log"), "error: " + r.invalid + "\n");
