@@ -157,6 +157,11 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
   const auto r = nlohmann::json::parse(in);
   CHECK(r["experiment"] == "crusher");
   CHECK(!r.contains("experiment_status"));  // ended by the empty chamber, not by end_time
+  // Bodies at the start and at the end (all discharged), both on the page.
+  CHECK(r["particles_at_start"] == 6);
+  CHECK(r["particles"] == 0);
+  const std::string page = test::slurp(out / "report.html");
+  CHECK(page.find("<td>particles (balls) / clumps at the start</td><td>6 / 0</td>") != std::string::npos);
   const auto& c = r["crusher"];
   INFO(c.dump());
   CHECK(c["feed_balls"] == 6);

@@ -110,9 +110,12 @@ std::string whatWasRun(const json& r) {
   if (settings.contains("end_time_s")) add("end time (s)", valueCell(settings["end_time_s"]));
   if (settings.contains("steps")) add("step limit", valueCell(settings["steps"]));
   add("seed", valueCell(r.value("seed", json())));
-  add("particles (balls) / clumps / walls", valueCell(r.value("particles", json())) + " / " +
-                                                valueCell(r.value("clumps", json())) + " / " +
-                                                valueCell(r.value("walls", json())));
+  if (r.contains("particles_at_start"))
+    add("particles (balls) / clumps at the start", valueCell(r["particles_at_start"]) + " / " +
+                                                       valueCell(r.value("clumps_at_start", json())));
+  add("particles (balls) / clumps / walls at the end", valueCell(r.value("particles", json())) + " / " +
+                                                           valueCell(r.value("clumps", json())) + " / " +
+                                                           valueCell(r.value("walls", json())));
   add("time step dt (s)", valueCell(r.value("dt_s", json())));
   add("steps (this run)", valueCell(r.value("steps_this_run", json())));
   add("simulated time (s)", valueCell(r.value("simulated_time_s", json())));
@@ -122,7 +125,7 @@ std::string whatWasRun(const json& r) {
     for (const json& x : r["modules"]) m += (m.empty() ? "" : ", ") + valueCell(x);
     add("modules", m);
   }
-  add("rocklab commit (at configure time)", settings.contains("commit") ? valueCell(settings["commit"]) : "unknown");
+  add("rocklab commit (at build time)", settings.contains("commit") ? valueCell(settings["commit"]) : "unknown");
   add("state hash", valueCell(r.value("state_hash", json())));
   return htmlSection("What was run", htmlTable({"setting", "value"}, rows));
 }

@@ -107,6 +107,8 @@ class RunLoop {
 
   RunRecord run() {
     record_.first_step = world_->stepCount();
+    record_.start_balls = world_->particles().size();
+    record_.start_clumps = world_->particles().clumps.size();
     end_step_ = std::max(setup_.total_steps, record_.first_step);
     record_.loop_start = Clock::now();
     try {

@@ -120,8 +120,10 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["status"] = record.status;
   if (!record.message.empty()) r["message"] = record.message;
   r["warnings"] = warningsJson(record);
-  r["particles"] = world.particles().size();
+  r["particles"] = world.particles().size();  // at the end (an experiment may have removed bodies)
   r["clumps"] = world.particles().clumps.size();
+  r["particles_at_start"] = record.start_balls;
+  r["clumps_at_start"] = record.start_clumps;
   if (!scene.clump_shapes.empty()) r["clump_shapes"] = clumpShapesJson(scene.clump_shapes);
   r["walls"] = world.model().walls.size();
   r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
