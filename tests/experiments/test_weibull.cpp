@@ -6,9 +6,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analysis/batch_curves.h"
 #include "analysis/strength_groups.h"
 #include "analysis/weibull.h"
 #include "analysis/weibull_report.h"
@@ -162,5 +164,70 @@ TEST_CASE("weibull: strength statistics per group and the size effect over the g
   std::ostringstream bad;
   CHECK(experiments::strengthGroupsCommand(dir, {"strength_MPa", "particles.0.r0", ""}, bad) == 2);
   CHECK_THAT(bad.str(), Catch::Contains("no column 'particles.0.r0'"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("weibull: a batch's force-displacement curves, one colour and legend entry per group", "[weibull]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rocklab-batch-curves-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  // Four planned runs: two of r0 = 2 and one of r0 = 3 finished; one never ran.
+  const std::vector<std::pair<std::string, std::string>> runs = {{"r0=2__s=1", "2"}, {"r0=2__s=2", "2"},
+                                                                 {"r0=3__s=1", "3"}, {"r0=3__s=2", "3"}};
+  nlohmann::json plan = {{"kind", "sweep"}, {"scene", "zwick-dense-r0"}, {"overrides", nlohmann::json::array()},
+                         {"metrics", {"strength_MPa"}},
+                         {"vary", {{{"key", "particles.0.r0"}, {"values", {"2", "3"}}},
+                                   {{"key", "particles.0.seed"}, {"values", {"1", "2"}}}}}};
+  for (const auto& [name, r0] : runs)
+    plan["runs"].push_back({{"name", name}, {"values", {r0, name.back() == '1' ? "1" : "2"}}, {"overrides", nlohmann::json::array()}});
+  fs::create_directories(dir);
+  std::ofstream(dir / "plan.json") << plan.dump();
+  // Run k: force (k + 1) * 10 kN a mm of travel, 1000 rows of 1 um (more than are drawn).
+  for (std::size_t k = 0; k < 3; ++k) {
+    const fs::path run = dir / "runs" / runs[k].first;
+    fs::create_directories(run);
+    std::ofstream(run / "results.json") << R"({"status": "completed"})";
+    std::ofstream csv(run / "force_displacement.csv");
+    csv << "time_s,travel_m,platen_gap_m,top_force_N,bottom_force_N\n";
+    for (int i = 0; i <= 1000; ++i) csv << i * 1e-5 << ',' << i * 1e-6 << ",0.05," << (k + 1) * 1e7 * i * 1e-6 << ",0\n";
+  }
+  std::ostringstream log;
+  const std::size_t drawn = experiments::writeBatchForceCurves(dir, "particles.0.r0", log);
+  INFO(log.str());
+  REQUIRE(drawn == 3);
+  REQUIRE(fs::exists(dir / "force_displacement.png"));
+  // The plotted data: each curve under its run's name, in mm and kN, the last point kept.
+  std::ifstream data(dir / "force_displacement.plot.csv");
+  std::string line;
+  std::getline(data, line);
+  std::map<std::string, std::pair<std::size_t, double>> last;  // points, last force (kN) at 1 mm
+  while (std::getline(data, line)) {
+    const auto a = line.find(','), b = line.rfind(',');
+    auto& entry = last[line.substr(0, a)];
+    ++entry.first;
+    if (std::stod(line.substr(a + 1, b - a - 1)) == Approx(1.0)) entry.second = std::stod(line.substr(b + 1));
+  }
+  REQUIRE(last.size() == 3);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& [points, force] = last.at(runs[k].first);
+    CHECK(points <= 601);  // thinned for the plot
+    CHECK(points >= 300);
+    CHECK(force == Approx(10.0 * (k + 1)));
+  }
+  // One legend entry per group, with its count of runs.
+  const std::string svg = [&] {
+    std::ifstream in(dir / "force_displacement.svg");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  if (!svg.empty()) {  // gnuplot present
+    CHECK(svg.find("particles.0.r0 = 2: 2 runs") != std::string::npos);
+    CHECK(svg.find("particles.0.r0 = 3: 1 run") != std::string::npos);
+  }
+  // Not a crushing batch (no curves) and not a set folder: nothing written.
+  fs::remove_all(dir / "runs");
+  fs::remove(dir / "force_displacement.png");
+  CHECK(experiments::writeBatchForceCurves(dir, "particles.0.r0", log) == 0);
+  CHECK(!fs::exists(dir / "force_displacement.png"));
+  CHECK(experiments::writeBatchForceCurves(dir / "nothing", "", log) == 0);
   fs::remove_all(dir);
 }

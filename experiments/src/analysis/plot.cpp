@@ -86,7 +86,9 @@ std::string plotCsv(const PlotSpec& spec) {
   char number[64];
   for (std::size_t k = 0; k < spec.series.size(); ++k) {
     const PlotSeries& s = spec.series[k];
-    const std::string name = csvCell(s.label.empty() ? "series " + std::to_string(k + 1) : s.label);
+    const std::string name = csvCell(!s.data_name.empty() ? s.data_name
+                                     : s.label.empty()    ? "series " + std::to_string(k + 1)
+                                                          : s.label);
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       std::snprintf(number, sizeof number, ",%.10g,%.10g\n", s.x[i], s.y[i]);
       csv += name + number;

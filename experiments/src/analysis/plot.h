@@ -3,6 +3,7 @@
 // results (angle vs friction, profiles, force-displacement, Weibull, ...). Drawn by
 // gnuplot (Debian gnuplot-nox) as PNG and SVG, the plotted data as CSV beside them;
 // without gnuplot, by the built-in OpenCV plotter as PNG only (plot_internal.h).
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -15,7 +16,17 @@ struct PlotSeries {
   std::string label;         // legend text ("" = not in the legend)
   std::vector<double> x, y;  // same length; non-finite points are skipped (a line breaks there)
   enum class Style { Line, Points, LinePoints } style = Style::LinePoints;
+  // Index into the palette; -1: the series' own index. Curves of one group share one
+  // colour (a crushing batch: one colour per r0, one legend entry per group).
+  int colour = -1;
+  // Its name in the plotted data (plotDataPath): "" = the label, or "series K" without one.
+  std::string data_name = "";
 };
+
+/// The palette index a series is drawn with (its `colour`, else its index `k`).
+inline std::size_t colourIndexOf(const PlotSeries& s, std::size_t k) {
+  return s.colour >= 0 ? static_cast<std::size_t>(s.colour) : k;
+}
 
 struct PlotSpec {
   std::string title, x_label, y_label;  // labels carry units, e.g. "time (s)"

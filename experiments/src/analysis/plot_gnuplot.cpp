@@ -76,7 +76,7 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
     const std::string block = "$s" + std::to_string(k);
     s += block + " << EOD\n" + data + "EOD\n";
     plot += std::string(plot.empty() ? "plot " : ", ") + block + " using 1:2 " + withStyle(series.style) +
-            " lc rgb '" + kPalette[k % kPalette.size()] + "' " +
+            " lc rgb '" + kPalette[colourIndexOf(series, k) % kPalette.size()] + "' " +
             (series.label.empty() ? std::string("notitle") : "title " + quoted(series.label));
   }
   if (plot.empty()) plot = "plot NaN notitle";  // axes only

@@ -157,7 +157,7 @@ void drawPlotWithOpenCv(const PlotSpec& logged, const std::filesystem::path& png
   const cv::Rect2d inside(-8, -8, box.width + 16, box.height + 16);  // the box and a margin for line caps
   for (std::size_t k = 0; k < spec.series.size(); ++k) {
     const PlotSeries& s = spec.series[k];
-    const cv::Scalar colour = kPalette[k % kPalette.size()];
+    const cv::Scalar colour = kPalette[colourIndexOf(s, k) % kPalette.size()];
     auto finite = [&](std::size_t i) { return std::isfinite(s.x[i]) && std::isfinite(s.y[i]); };
     if (s.style != PlotSeries::Style::Points)
       for (std::size_t i = 1; i < s.x.size(); ++i)
@@ -200,7 +200,7 @@ void drawPlotWithOpenCv(const PlotSpec& logged, const std::filesystem::path& png
     cv::rectangle(img, legend, kFrame, 1);
     for (std::size_t e = 0; e < entries.size(); ++e) {
       const PlotSeries& s = spec.series[entries[e]];
-      const cv::Scalar colour = kPalette[entries[e] % kPalette.size()];
+      const cv::Scalar colour = kPalette[colourIndexOf(s, entries[e]) % kPalette.size()];
       const int y = legend.y + 5 + row / 2 + static_cast<int>(e) * row;
       if (s.style != PlotSeries::Style::Points)
         cv::line(img, {legend.x + 8, y}, {legend.x + 38, y}, colour, 2, cv::LINE_AA);

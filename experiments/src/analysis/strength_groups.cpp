@@ -7,6 +7,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "analysis/batch_curves.h"
 #include "analysis/plot.h"
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
@@ -185,6 +186,7 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
   }
   log << "strength groups: " << (dir / "strength_groups.csv").string() << ", "
       << (dir / "strength_groups.png").string() << "\n";
+  writeBatchForceCurves(dir, o.group_by, log);
   return kExitOk;
 }
 

@@ -40,13 +40,11 @@ std::optional<double> SweepTable::numberIn(const std::vector<std::string>& row, 
   return std::nullopt;
 }
 
-SweepTable readSweepTable(const std::filesystem::path& dir) {
+SweepTable readCsvTable(const std::filesystem::path& file, const std::string& missing_hint) {
   SweepTable t;
-  t.file = dir / "sweep.csv";
+  t.file = file;
   std::ifstream in(t.file);
-  if (!in)
-    throw std::invalid_argument(t.file.string() +
-                                ": cannot read (run a sweep over the batch first, e.g. --vary scene.seed=1,2,...)");
+  if (!in) throw std::invalid_argument(t.file.string() + ": cannot read" + missing_hint);
   std::string line;
   if (!std::getline(in, line)) throw std::invalid_argument(t.file.string() + ": empty (no header)");
   t.header = splitCsv(line);
@@ -61,6 +59,10 @@ SweepTable readSweepTable(const std::filesystem::path& dir) {
       t.rows.push_back(std::move(cells));
   }
   return t;
+}
+
+SweepTable readSweepTable(const std::filesystem::path& dir) {
+  return readCsvTable(dir / "sweep.csv", " (run a sweep over the batch first, e.g. --vary scene.seed=1,2,...)");
 }
 
 }  // namespace rocklab::experiments

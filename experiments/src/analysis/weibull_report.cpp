@@ -6,6 +6,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "analysis/batch_curves.h"
 #include "analysis/plot.h"
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
@@ -79,6 +80,7 @@ int weibullCommand(const std::filesystem::path& dir, const std::string& column, 
       << ", sigma0 = " << fit.sigma0 << " MPa, R^2 = " << fit.r2 << ", mean " << fit.mean
       << " MPa, CoV " << fit.cov << "; " << (dir / "weibull.json").string() << ", "
       << (dir / "weibull.png").string() << "\n";
+  writeBatchForceCurves(dir, "", log);
   return kExitOk;
 }
 

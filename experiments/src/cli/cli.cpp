@@ -296,7 +296,7 @@ void addCommands(CLI::App& app, CliArgs& a) {
   report->add_option("dir", a.collect_dir, "Folder of a run (holds results.json) or of a set (plan.json, runs/)")->required();
 
   auto* weibull = app.add_subcommand(
-      "weibull", "Weibull analysis of a batch of crushing runs (a sweep folder): weibull.json and the Weibull plot");
+      "weibull", "Weibull analysis of a batch of crushing runs (a sweep folder): weibull.json, the Weibull plot and the force-displacement curves of its runs");
   weibull->add_option("dir", a.collect_dir, "Folder of the batch's sweep (holds sweep.csv)")->required();
   weibull->add_option("--column", a.weibull_column, "sweep.csv column with the strengths in MPa")
       ->capture_default_str();
