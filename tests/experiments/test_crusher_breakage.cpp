@@ -131,7 +131,7 @@ sim::Energy energyAfterStep(std::unique_ptr<sim::World>& world) {
 
 }  // namespace
 
-TEST_CASE("a ball between two closing walls breaks when q exceeds its strength and not before; the freeze parts the "
+TEST_CASE("a ball between two closing walls breaks when q exceeds its strength and not before, and the freeze parts the "
           "fragments without creating energy",
           "[crusher]") {
   std::unique_ptr<sim::World> world = pinchedBall(0.2);
