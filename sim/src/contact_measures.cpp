@@ -47,6 +47,9 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 /// overlap of a step ago).
 template <class Law, class PairVisit, class WallVisit>
 void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const {
+  // A World built from spheres has no contact lists before its first step (it
+  // builds them there): no contacts yet.
+  if (nb.pairs.row_offset.size() != p.size() + 1) return;
   std::vector<detail::WallRuntime> walls_now = walls;
   for (std::size_t k = 0; k < walls_now.size(); ++k) walls_now[k].update(model.walls[k], time);
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "cli_support.h"
+#include "crusher_support.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/geometry/mantle_motion.h"
 #include "rocklab/sim/wall_motion.h"
@@ -133,26 +134,12 @@ TEST_CASE("the crusher's mantle wall: gyration in the pose, Eq 6-9 spin in the v
 }
 
 TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving chamber and is discharged", "[cli][crusher]") {
-  // The PBM scene with six 8-9 mm spheres (finer than the 11.6 mm closed-side
-  // gap), soft contacts (a coarse step) and the stop wall gone at 0.02 s: every
-  // ball must reach the discharge below the chamber, its size recorded, and the
-  // run end there (the chamber is empty). The walls' ParaView series shows the
-  // mantle at its pose.
-  const std::string scene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/cone-crusher-pbm.toml";
+  // The PBM scene with six 8-9 mm spheres (crusher_support.h): every ball must
+  // reach the discharge below the chamber, its size recorded, and the run end
+  // there (the chamber is empty). The walls' ParaView series shows the mantle at
+  // its pose.
   const fs::path out = test::scratchDir("crusher-run");
-  std::vector<std::string> args{"run", scene, "--out", out.string(), "--threads", "1", "--quiet",
-                                "--set", "crusher.release_time=0.02", "--set", "scene.end_time=2.0",
-                                "--set", "output.frame_interval=0.05"};
-  for (const char* m : {"rock_small", "rock_medium", "rock_large"})
-    for (const char* k : {"kn", "ks"}) args.insert(args.end(), {"--set", std::string("materials.") + m + "." + k + "=1e7"});
-  for (int s = 0; s < 3; ++s) {
-    const std::string p = "particles." + std::to_string(s) + ".";
-    const double z = 0.165 + 0.035 * s;
-    args.insert(args.end(), {"--set", p + "count=2", "--set", p + "radius_min=0.004", "--set", p + "radius_max=0.0045",
-                             "--set", p + "region_min=[-0.045,-0.045," + std::to_string(z) + "]",
-                             "--set", p + "region_max=[0.045,0.045," + std::to_string(z + 0.035) + "]"});
-  }
-  REQUIRE(test::cli(args) == 0);
+  REQUIRE(test::cli(test::tinyCrusherRunArgs(out.string())) == 0);
   std::ifstream in(out / "results.json");
   const auto r = nlohmann::json::parse(in);
   CHECK(r["experiment"] == "crusher");

@@ -37,6 +37,19 @@ TEST_CASE("particle stress: a sphere between two platens gives q = (2 sqrt 2 / p
         1e-9);  // the least compressive direction is in the xy plane
 }
 
+TEST_CASE("particle stress and wall loads of a world not stepped yet are zero (its contact lists come with the first step)",
+          "[stress]") {
+  // The crusher's breakage check may look before the first step.
+  const double r = 0.01;
+  sim::Model model = test::linearModel(1e6);
+  model.walls = {test::plane("bottom", Vec3(0, 0, -r + 1e-6), Vec3::UnitZ())};
+  const sim::World world(model, {test::sphere(Vec3::Zero(), r), test::sphere(Vec3(0.019, 0, 0), r)}, 1);
+  const std::vector<Mat3> stress = world.particleStress();
+  REQUIRE(stress.size() == 2);
+  CHECK(stress[0] == Mat3::Zero());
+  CHECK(world.wallForces()[0] == Vec3::Zero());
+}
+
 TEST_CASE("wall load: a moving platen's load is read where the platen is now, not a step ago",
           "[stress][walls]") {
   // A ball too heavy to move; a plane closing on it at v. Its load after a step

@@ -5,6 +5,9 @@
 // engine keeps a constant model), and results.json gets the product's size
 // distribution (mass percent passing each sieve) and its mass balance against
 // the feed. Spheres only (the crusher's PBM feed); clumps are refused at the start.
+// With [experiment.breakage] the balls break (crusher_breakage.h): the product
+// then holds fragments, and results.json's crusher.breakage the events and the
+// mass balance (feed = product + what is still in the chamber).
 #include "drivers/crusher_experiment.h"
 
 #include <algorithm>
@@ -27,7 +30,8 @@ struct ProductBall {
 
 class CrusherRunExperiment final : public Experiment {
  public:
-  explicit CrusherRunExperiment(const Scene& scene) : e_(settingsOf<CrusherRunSettings>(scene)) {}
+  explicit CrusherRunExperiment(const Scene& scene)
+      : e_(settingsOf<CrusherRunSettings>(scene)), breakage_(e_.breakage, scene.run.seed) {}
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     const sim::ParticleState& p = world->particles();
@@ -38,9 +42,18 @@ class CrusherRunExperiment final : public Experiment {
       every_ = stepsIn(e_.sample_interval, world->dt());
       feed_count_ = p.size();
       for (std::size_t i = 0; i < p.size(); ++i) feed_mass_ += p.mass[i];
+      chamber_mass_ = feed_mass_;
+      if (e_.breakage.enabled) breakage_.start(*world, e_.sample_interval);
     }
-    if (p.size() == 0) return false;  // the chamber is empty
+    if (world->particles().size() == 0) return false;  // the chamber is empty
+    if (e_.breakage.enabled && breakage_.check(world, ctx)) chamber_mass_ = massOf(world->particles());
     if (world->stepCount() % every_ != 0) return true;
+    return discharge(world, ctx);
+  }
+
+  /// Removes the balls below discharge_height (product); false when none is left.
+  bool discharge(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    const sim::ParticleState& p = world->particles();
     std::vector<bool> remove(p.size(), false);
     bool any = false;
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -50,6 +63,7 @@ class CrusherRunExperiment final : public Experiment {
     }
     if (any) {
       switchPhase(world, ctx, [](sim::Model&) {}, remove);
+      chamber_mass_ = massOf(world->particles());
       if (world->particles().size() == 0) return false;
     }
     return true;
@@ -57,7 +71,8 @@ class CrusherRunExperiment final : public Experiment {
 
   std::string progress() const override {
     std::ostringstream s;
-    s << product_.size() << " of " << feed_count_ << " balls discharged";
+    s << product_.size() << " balls discharged";
+    if (e_.breakage.enabled) s << ", " << breakage_.events().size() << " broken";
     return s.str();
   }
 
@@ -83,14 +98,27 @@ class CrusherRunExperiment final : public Experiment {
     c["discharged_mass_kg"] = product_mass;
     c["first_discharge_s"] = product_.empty() ? nlohmann::json(nullptr) : nlohmann::json(product_.front().time);
     c["last_discharge_s"] = product_.empty() ? nlohmann::json(nullptr) : nlohmann::json(product_.back().time);
-    c["empty"] = product_.size() == feed_count_;
+    c["empty"] = chamber_mass_ == 0;
     c["discharge_height_m"] = e_.discharge_height;
     c["psd"] = psd;
     c["method"] = "a ball whose centre is below discharge_height is product: removed, its diameter and mass recorded "
                   "(product.csv); psd = mass fraction of the product finer than each sieve size";
+    c["in_chamber_mass_kg"] = chamber_mass_;
+    if (e_.breakage.enabled) {
+      nlohmann::json b = breakage_.report(e_.sieves_mm, out_dir);
+      // Breakage conserves mass to round-off: the feed is the product and what is left.
+      b["mass_balance"] = {{"feed_kg", feed_mass_},
+                           {"product_kg", product_mass},
+                           {"in_chamber_kg", chamber_mass_},
+                           {"relative_difference", (feed_mass_ - product_mass - chamber_mass_) / feed_mass_}};
+      c["breakage"] = b;
+    }
     r["crusher"] = c;
-    log << "crusher: " << product_.size() << " of " << feed_count_ << " balls discharged (" << product_mass
-        << " kg of " << feed_mass_ << " kg)\n";
+    log << "crusher: " << product_.size() << " balls discharged (" << product_mass << " kg of " << feed_mass_
+        << " kg fed)";
+    if (e_.breakage.enabled)
+      log << ", " << breakage_.events().size() << " broke into " << breakage_.fragmentsCreated() << " fragments";
+    log << "\n";
   }
 
  private:
@@ -99,7 +127,15 @@ class CrusherRunExperiment final : public Experiment {
   std::uint64_t every_ = 1;
   std::size_t feed_count_ = 0;
   double feed_mass_ = 0;
+  double chamber_mass_ = 0;  // kg still in the run, updated at every discharge and breakage
   std::vector<ProductBall> product_;
+  CrusherBreakage breakage_;
+
+  static double massOf(const sim::ParticleState& p) {
+    double m = 0;
+    for (const double b : p.mass) m += b;
+    return m;
+  }
 };
 
 }  // namespace
@@ -116,6 +152,7 @@ std::shared_ptr<ExperimentSettings> readCrusherRunSettings(TableReader& t, const
     if (!std::is_sorted(settings->sieves_mm.begin(), settings->sieves_mm.end()) || settings->sieves_mm.empty())
       t.fail("sieves_mm", "must be a non-empty list of sizes in increasing order (mm)");
   }
+  readBreakageSettings(t, settings->breakage);
   return settings;
 }
 

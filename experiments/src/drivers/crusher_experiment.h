@@ -4,8 +4,10 @@
 // [crusher]); this driver detects the discharge below the chamber: a sphere whose
 // centre falls below discharge_height is product, counted with its size and
 // removed. The run ends when no ball is left (the chamber is empty) or at end_time.
+// With [experiment.breakage] balls break (§g.6, drivers/crusher_breakage.h).
 #include <memory>
 
+#include "drivers/crusher_breakage.h"
 #include "drivers/experiment.h"
 #include "drivers/experiment_settings.h"
 
@@ -15,6 +17,7 @@ struct CrusherRunSettings final : ExperimentSettings {
   double discharge_height = -0.03;  // m: a ball whose centre is lower is product (below the concave's lip)
   // Sieve apertures of the product's cumulative passing (mass), mm.
   std::vector<double> sieves_mm{2, 4, 5.6, 8, 11.2, 14, 16, 20, 22.4, 25, 28, 31.5};
+  BreakageSettings breakage;  // [experiment.breakage]; off without the table
 };
 
 std::shared_ptr<ExperimentSettings> readCrusherRunSettings(TableReader& table, const SettingsContext& context);

@@ -279,6 +279,24 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher", "", "", "type = \"crusher\": the cone crusher's run (docs/crusher.md): spheres below discharge_height are product (removed, size and mass in product.csv); ends when the chamber is empty."},
       {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
       {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},
+      {"experiment.crusher.breakage", "", "", "[experiment.breakage] of type = \"crusher\": population-balance breakage (experiments.md §g.6, docs/crusher.md); off without the table. A ball of at least min_diameter whose octahedral shear stress exceeds its strength is replaced by fragments, which a freeze eases apart."},
+      {"experiment.crusher.breakage", "check_interval", "s", "Time between breakage checks; 0 = the experiment's sample_interval. Impacts shorter than it can be missed."},
+      {"experiment.crusher.breakage", "q_ref", "Pa", "q0 at d_ref: the octahedral shear strength 37 % of the balls of that size exceed (Weibull scale)."},
+      {"experiment.crusher.breakage", "d_ref", "m", "Size q_ref belongs to ([I]: 21 mm, the middle of the 14-28 mm feed)."},
+      {"experiment.crusher.breakage", "size_exponent", "", "b of the size effect q0(d) = q_ref (d / d_ref)^b (Eq 6-13)."},
+      {"experiment.crusher.breakage", "weibull_modulus", "", "m: a ball's strength is q0(d) (-ln U)^(1/m), U drawn from scene.seed and the ball's id."},
+      {"experiment.crusher.breakage", "min_diameter", "m", "Balls smaller than this never break (Table 6.2: 4 mm); also sets the smallest fragment the step must hold."},
+      {"experiment.crusher.breakage", "mode", "", "Fragments: three of 60/30/10 % of the mass, or two halves.", "\"triple\", \"equal\""},
+      {"experiment.crusher.breakage", "offsets", "", "Fragment centres along the minor principal stress direction, in parent radii, one per fragment, each fragment inside the parent. Default: triple [-0.157, 0.331, 0] (60 % and 30 % internally tangent at opposite ends, 10 % at the centre), equal [-0.206, 0.206]."},
+      {"experiment.crusher.breakage", "youngs_modulus", "Pa", "E_c of the fragments' stiffness k = 4 R E_c (Eq 6-14), R the middle of the fragment's size class."},
+      {"experiment.crusher.breakage", "class_ratio", "", "Width of the fragments' size classes (diameters min_diameter x ratio^i to ^(i+1)); each class is a material with its own k."},
+      {"experiment.crusher.breakage", "freeze_density", "kg/m^3", "Every ball's density during the freeze (§g.6 step 3)."},
+      {"experiment.crusher.breakage", "freeze_stiffness", "N/m", "The fragments' kn and ks during the freeze (§g.6 step 4)."},
+      {"experiment.crusher.breakage", "freeze_local_damping", "", "Local damping alpha during the freeze (§g.6 step 5; viscous damping off)."},
+      {"experiment.crusher.breakage", "freeze_overlap_fraction", "", "The freeze may end when no fragment overlaps a ball by more than this fraction of the smaller radius."},
+      {"experiment.crusher.breakage", "freeze_kinetic_fraction", "", "...and the kinetic energy is below this fraction of the energy the fragments' overlaps stored at the freeze stiffness."},
+      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended after this many cycles stops the run (with the criterion's values)."},
+      {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
       {"experiment.zwick", "top_platen", "", "Plane wall that closes on the specimen.", "a plane wall name"},
@@ -528,6 +546,37 @@ library = "LIBRARY"
 index = 0
 position = [1, 0, 0]
 )",
+    R"(
+[scene]
+name = "coverage-crusher-breakage"
+steps = 1
+[materials.rock]
+[[particles]]
+type = "list"
+material = "rock"
+radius = 0.01
+positions = [[0, 0, 0]]
+[experiment]
+type = "crusher"
+[experiment.breakage]
+check_interval = 0.001
+q_ref = 25.2e6
+d_ref = 0.021
+size_exponent = -1.1
+weibull_modulus = 2.65
+min_diameter = 0.004
+mode = "triple"
+offsets = [-0.15, 0.33, 0]
+youngs_modulus = 70e9
+class_ratio = 1.25
+freeze_density = 3e9
+freeze_stiffness = 1e3
+freeze_local_damping = 0.9
+freeze_overlap_fraction = 1e-4
+freeze_kinetic_fraction = 0.2
+freeze_max_cycles = 200000
+freeze_check_cycles = 20
+)",
 };
 
 /// A library of one agglomerate (two bonded spheres) for the coverage scene.
@@ -563,8 +612,12 @@ std::string joined(const std::vector<std::string>& values, const std::string& se
 std::string heading(const std::string& table) {
   if (table == "walls" || table == "particles" || table == "cameras" || table == "gravity.change")
     return "[[" + table + "]]";
-  if (table.rfind("experiment.", 0) == 0)
-    return "[experiment] type = \"" + table.substr(11) + "\"";
+  if (table.rfind("experiment.", 0) == 0) {
+    // A driver's sub-table ("experiment.crusher.breakage"): [experiment.breakage] of that type.
+    const std::string type = table.substr(11), sub = type.substr(0, type.find('.'));
+    if (sub != type) return "[experiment." + type.substr(sub.size() + 1) + "] of type = \"" + sub + "\"";
+    return "[experiment] type = \"" + type + "\"";
+  }
   return "[" + table + "]";
 }
 

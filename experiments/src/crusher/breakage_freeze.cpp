@@ -1,0 +1,141 @@
+#include "crusher/breakage_freeze.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "rocklab/sim/timestep.h"
+#include "rocklab/sim/wall_motion.h"
+
+namespace rocklab::experiments::crusher {
+
+namespace {
+
+using geometry::Vec3;
+
+/// The wall where its motion has it at time t, without the motion; a wall not
+/// there at t is never active.
+sim::Wall heldWall(const sim::Wall& moving, double t) {
+  sim::Wall w = moving;
+  const sim::WallPose pose = sim::wallPoseAt(moving.motion, t);
+  w.point = pose.place(moving.point);
+  w.normal = pose.rotation * moving.normal;
+  for (Vec3& v : w.vertices) v = pose.place(v);
+  for (Vec3& v : w.mesh.vertices) v = pose.place(v);
+  w.motion = sim::WallMotion{};
+  w.active_from = -std::numeric_limits<double>::infinity();
+  w.active_until = moving.activeAt(t) ? std::numeric_limits<double>::infinity() : std::numeric_limits<double>::lowest();
+  return w;
+}
+
+/// §g.6 steps 2-6 as a model: held walls, no gravity, no dashpots, local damping,
+/// the fragments on soft copies of their materials (rows of `material` changed).
+sim::Model freezeModel(const sim::Model& run, double t, std::vector<std::int32_t>& material,
+                       const std::vector<std::uint32_t>& fragments, const FreezeSettings& s) {
+  sim::Model m = run;
+  for (sim::Wall& w : m.walls) w = heldWall(w, t);
+  m.gravity = Vec3::Zero();
+  m.gravity_changes.clear();
+  m.contact.damping_normal = m.contact.damping_shear = 0.0;
+  m.contact.local_damping = s.local_damping;
+  m.timestep.dt = 0.0;  // its own automatic step
+  m.timestep.allow_unsafe = false;
+  m.relaxation.steps = 0;
+  // The fragments overlap by design: the overlap watchdog is off; the energy one
+  // stays (the freeze only dissipates); the network check costs and finds nothing.
+  m.watchdog.max_overlap_fraction = std::numeric_limits<double>::infinity();
+  m.watchdog.network_iterations = 0;
+  std::map<std::int32_t, std::int32_t> soft;  // run material -> its soft copy
+  for (const std::uint32_t f : fragments) {
+    auto [it, added] = soft.try_emplace(material[f], static_cast<std::int32_t>(m.materials.size()));
+    if (added) {
+      sim::Material copy = run.materials[material[f]];
+      copy.name += " (freeze)";
+      copy.kn = copy.ks = s.stiffness;
+      m.materials.push_back(copy);
+    }
+    material[f] = it->second;
+  }
+  return m;
+}
+
+double kineticEnergy(const sim::ParticleState& p) {
+  double e = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() + 0.5 * p.omega[i].squaredNorm() / p.inv_inertia[i];
+  return e;
+}
+
+}  // namespace
+
+FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
+                                  const std::vector<std::uint32_t>& fragments) {
+  std::vector<bool> is_fragment(p.size(), false);
+  for (const std::uint32_t f : fragments) is_fragment[f] = true;
+  FragmentOverlaps o;
+  for (const std::uint32_t f : fragments)
+    for (std::uint32_t j = 0; j < p.size(); ++j) {
+      if (j == f || (is_fragment[j] && j < f)) continue;  // each fragment pair once
+      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+      if (!(overlap > 0)) continue;
+      o.max_fraction = std::max(o.max_fraction, overlap / std::min(p.radius[f], p.radius[j]));
+      const double kf = model.materials[p.material[f]].kn, kj = model.materials[p.material[j]].kn;
+      o.energy += 0.5 * kf * kj / (kf + kj) * overlap * overlap;
+    }
+  return o;
+}
+
+FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
+                             const std::vector<std::uint32_t>& fragments, const FreezeSettings& s, int threads) {
+  sim::WorldState frozen = state;
+  sim::ParticleState& p = frozen.particles;
+  const sim::Model m = freezeModel(model, state.time, p.material, fragments, s);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double r = p.radius[i];
+    p.mass[i] = s.density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    p.inv_mass[i] = 1.0 / p.mass[i];
+    p.inv_inertia[i] = 1.0 / (0.4 * p.mass[i] * r * r);
+    p.velocity[i] = p.omega[i] = Vec3::Zero();
+  }
+  FreezeResult result;
+  result.dt = sim::auditTimestep(m, p).automatic;
+  frozen.time = 0.0;  // the freeze's own clock (time = step x dt)
+  frozen.step = 0;
+  frozen.dt = result.dt;
+  frozen.half_kick_pending = true;
+  sim::World world(m, std::move(frozen), threads);
+  result.artificial_energy = fragmentOverlaps(m, world.particles(), fragments).energy;
+  for (;;) {
+    if (result.cycles % static_cast<std::uint64_t>(s.check_cycles) == 0) {
+      result.max_overlap = fragmentOverlaps(m, world.particles(), fragments).max_fraction;
+      result.kinetic_energy = kineticEnergy(world.particles());
+      if (result.max_overlap <= s.overlap_fraction &&
+          result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy)
+        break;
+      if (result.cycles >= static_cast<std::uint64_t>(s.max_cycles)) {
+        std::ostringstream msg;
+        msg << "experiment.breakage: the freeze after breakage at t = " << state.time << " s did not end within "
+            << "freeze_max_cycles = " << s.max_cycles << " cycles: the largest fragment overlap is "
+            << result.max_overlap << " of the smaller radius (freeze_overlap_fraction = " << s.overlap_fraction
+            << ") and the kinetic energy " << result.kinetic_energy << " J is "
+            << result.kinetic_energy / result.artificial_energy << " of the fragments' initial "
+            << result.artificial_energy << " J (freeze_kinetic_fraction = " << s.kinetic_fraction
+            << "); raise freeze_max_cycles or relax the criterion (the fragments may have no room to separate)";
+        throw std::runtime_error(msg.str());
+      }
+    }
+    world.step();
+    ++result.cycles;
+  }
+  const sim::WorldState after = world.exportState();
+  state.particles.position = after.particles.position;
+  state.pair_history = after.pair_history;
+  state.wall_history = after.wall_history;
+  return result;
+}
+
+}  // namespace rocklab::experiments::crusher

@@ -1,0 +1,70 @@
+#pragma once
+// The "freeze" after breakage events (experiments.md §g.6 steps 1-8): the new
+// fragments overlap each other (they were placed inside their parent) and their
+// neighbours; released at the rock's stiffness that overlap would fire them apart
+// and break them again. The freeze eases them apart in a World of its own:
+//
+//   - everything at rest (the run's velocities stay in the caller's state: step 1,
+//     and step 8 gives them back untouched);
+//   - walls held where they are at the breakage time (each wall's pose at t baked
+//     into its geometry, no motion): the freeze World has its own clock, so the
+//     run's simulated time does not advance and the mantle does not move;
+//   - every ball's mass from the huge density (3e9 kg/m^3), the fragments'
+//     stiffness (kn = ks) 1e3 N/m, no dashpots, local damping 0.9, no gravity;
+//   - its own step: the automatic step of that model (the freeze's masses and
+//     stiffnesses), not the run's;
+//   - cycled until (a) no fragment overlaps a ball by more than overlap_fraction of
+//     the smaller radius and (b) the kinetic energy is below kinetic_fraction of the
+//     artificial energy the fragments' overlaps stored at the start (at the freeze
+//     stiffness) [X]: pushed apart, that energy dissipated. Fragments that separate
+//     into free space coast (local damping stops accelerating motion only): under
+//     the local damping alpha they leave with about (1 - alpha) = 10 % of it, so the
+//     default 0.2 ends the freeze there rather than never;
+//   - more than max_cycles: the run stops with a message naming the settings.
+//
+// Only the positions (and the contact history at them) come back; masses,
+// stiffnesses, damping, gravity, wall motion and velocities are the run's again.
+#include <cstdint>
+#include <vector>
+
+#include "rocklab/sim/world.h"
+
+namespace rocklab::experiments::crusher {
+
+struct FreezeSettings {
+  double density = 3e9;           // kg/m^3, every ball's during the freeze
+  double stiffness = 1e3;         // N/m, the fragments' kn and ks during the freeze
+  double local_damping = 0.9;     // alpha
+  double overlap_fraction = 1e-4; // largest fragment overlap / smaller radius that ends it
+  double kinetic_fraction = 0.2;  // kinetic energy / the fragments' initial artificial energy that ends it
+  std::int64_t max_cycles = 200000;
+  std::int64_t check_cycles = 20;  // cycles between looks at the criterion
+};
+
+struct FreezeResult {
+  std::uint64_t cycles = 0;
+  double dt = 0.0;                 // s, the freeze's own step
+  double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
+  double max_overlap = 0.0;        // largest fragment overlap / smaller radius at the end
+  double kinetic_energy = 0.0;     // J, at the end (freeze masses)
+};
+
+/// Relaxes the balls `fragments` (rows of state.particles) of `state` at time
+/// state.time under `model` (the run's); on return state's positions and contact
+/// history are those after the freeze, everything else as it was. Throws
+/// std::runtime_error (the settings named) when max_cycles pass first.
+FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
+                             const std::vector<std::uint32_t>& fragments, const FreezeSettings& settings,
+                             int threads);
+
+/// The largest overlap of any of `fragments` with any ball, over the smaller radius
+/// of the pair, and the energy their overlaps store at the stiffnesses of `model`
+/// (linear springs in series; walls are not counted: the freeze holds them).
+struct FragmentOverlaps {
+  double max_fraction = 0.0;
+  double energy = 0.0;  // J
+};
+FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
+                                  const std::vector<std::uint32_t>& fragments);
+
+}  // namespace rocklab::experiments::crusher

@@ -1,0 +1,226 @@
+#include "drivers/crusher_breakage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/atomic_file.h"
+#include "rocklab/sim/particle_stress.h"
+#include "rocklab/sim/timestep.h"
+
+namespace rocklab::experiments {
+
+using detail::Range;
+using geometry::Vec3;
+
+void readBreakageSettings(detail::TableReader& experiment_table, BreakageSettings& s) {
+  auto b = experiment_table.table("breakage");
+  if (!b) return;
+  s.enabled = true;
+  s.check_interval = b->number("check_interval", s.check_interval, Range::nonNegative());
+  s.strength.q_ref = b->number("q_ref", s.strength.q_ref, Range::positive());
+  s.strength.d_ref = b->number("d_ref", s.strength.d_ref, Range::positive());
+  s.strength.size_exponent = b->number("size_exponent", s.strength.size_exponent);
+  s.strength.weibull_modulus = b->number("weibull_modulus", s.strength.weibull_modulus, Range::positive());
+  s.min_diameter = b->number("min_diameter", s.min_diameter, Range::positive());
+  s.mode = b->string("mode", "triple", {"triple", "equal"}) == "equal" ? crusher::SplitMode::Equal
+                                                                     : crusher::SplitMode::Triple;
+  s.offsets = b->has("offsets") ? b->numberList("offsets") : crusher::defaultOffsets(s.mode);
+  if (const std::string problem = crusher::offsetsProblem(s.mode, s.offsets); !problem.empty())
+    b->fail("offsets", problem);
+  s.youngs_modulus = b->number("youngs_modulus", s.youngs_modulus, Range::positive());
+  s.class_ratio = b->number("class_ratio", s.class_ratio,
+                            {1.0, std::numeric_limits<double>::infinity(), true, false});
+  crusher::FreezeSettings& f = s.freeze;
+  f.density = b->number("freeze_density", f.density, Range::positive());
+  f.stiffness = b->number("freeze_stiffness", f.stiffness, Range::positive());
+  f.local_damping = b->number("freeze_local_damping", f.local_damping, {0.0, 1.0, false, true});
+  f.overlap_fraction = b->number("freeze_overlap_fraction", f.overlap_fraction, Range::nonNegative());
+  f.kinetic_fraction = b->number("freeze_kinetic_fraction", f.kinetic_fraction, Range::nonNegative());
+  f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
+  f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
+  b->finish();
+}
+
+namespace {
+
+/// Appends a free sphere to `p` (the per-ball fields of particles.h); returns its row.
+std::uint32_t appendBall(sim::ParticleState& p, const Vec3& position, const Vec3& velocity, const Vec3& omega,
+                         double radius, double mass, int material, std::uint64_t id) {
+  p.position.push_back(position);
+  p.velocity.push_back(velocity);
+  p.omega.push_back(omega);
+  p.radius.push_back(radius);
+  p.inv_mass.push_back(1.0 / mass);
+  p.inv_inertia.push_back(1.0 / (0.4 * mass * radius * radius));  // Eq 2-8
+  p.material.push_back(material);
+  p.mass.push_back(mass);
+  p.id.push_back(id);
+  return static_cast<std::uint32_t>(p.size() - 1);
+}
+
+double ballVolume(double radius) {
+  return 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+}
+
+std::string mm(double metres) {
+  std::ostringstream s;
+  s.precision(4);
+  s << metres * 1e3;
+  return s.str();
+}
+
+}  // namespace
+
+CrusherBreakage::CrusherBreakage(BreakageSettings settings, std::uint64_t seed)
+    : s_(std::move(settings)), seed_(seed) {}
+
+int CrusherBreakage::fragmentMaterial(sim::Model& model, int material, double diameter) {
+  const auto base_it = base_of_.find(material);
+  const int base = base_it == base_of_.end() ? material : base_it->second;
+  const int size_class = static_cast<int>(std::floor(std::log(diameter / s_.min_diameter) / std::log(s_.class_ratio)));
+  const auto [it, added] = class_material_.try_emplace({base, size_class}, static_cast<int>(model.materials.size()));
+  if (!added) return it->second;
+  // k = 4 R E_c (Eq 6-14) at the class's geometric middle; the shear stiffness in
+  // the feed material's ratio.
+  const sim::Material& feed = model.materials[base];
+  sim::Material m = feed;
+  const double lo = s_.min_diameter * std::pow(s_.class_ratio, size_class), hi = lo * s_.class_ratio;
+  m.name = feed.name + " fragments " + mm(lo) + "-" + mm(hi) + " mm";
+  m.kn = 2.0 * lo * std::sqrt(s_.class_ratio) * s_.youngs_modulus;
+  m.ks = m.kn * (feed.kn > 0 ? feed.ks / feed.kn : 1.0);
+  model.materials.push_back(m);
+  base_of_[it->second] = base;
+  return it->second;
+}
+
+void CrusherBreakage::start(const sim::World& world, double sample_interval) {
+  const sim::Model& model = world.model();
+  if (model.contact.law != sim::ContactLaw::Linear)
+    throw std::invalid_argument(
+        "experiment.breakage needs contact.law = \"linear\" (Table 6.2: k = 4 R E_c per size class)");
+  every_ = stepsIn(s_.check_interval > 0 ? s_.check_interval : sample_interval, world.dt());
+  const sim::ParticleState& p = world.particles();
+  for (const std::uint64_t id : p.id) next_id_ = std::max(next_id_, id + 1);
+  // The step must hold the smallest fragment the breakage can make: the lightest
+  // piece of a ball of min_diameter, of each feed material, on its class's stiffness.
+  const std::vector<double> fractions = crusher::massFractions(s_.mode);
+  const double d = s_.min_diameter * std::cbrt(*std::min_element(fractions.begin(), fractions.end()));
+  sim::Model probe = model;
+  sim::ParticleState balls = p;
+  CrusherBreakage scratch = *this;  // the probe's materials must not enter the run's table
+  for (const int material : std::set<int>(p.material.begin(), p.material.end())) {
+    const int m = scratch.fragmentMaterial(probe, material, d);
+    appendBall(balls, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, model.materials[material].density * ballVolume(d / 2),
+               m, std::numeric_limits<std::uint64_t>::max() - static_cast<std::uint64_t>(material));
+  }
+  if (balls.size() == p.size()) return;
+  const sim::TimestepAudit audit = sim::auditTimestep(probe, balls);
+  if (world.dt() > audit.automatic * (1 + 1e-9)) {
+    std::ostringstream msg;
+    msg << "experiment.breakage: the step dt = " << world.dt() << " s is too long for the smallest fragment the "
+        << "breakage can make (d = " << d * 1e3 << " mm: min_diameter = " << s_.min_diameter * 1e3
+        << " mm split by mode, k = " << probe.materials.back().kn
+        << " N/m from youngs_modulus): its stable step is " << audit.automatic
+        << " s. Set timestep.dt to at most that, or raise experiment.breakage.min_diameter or lower "
+           "experiment.breakage.youngs_modulus";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+  if (world->stepCount() % every_ != 0) return false;
+  const sim::ParticleState& p = world->particles();
+  if (p.size() == 0) return false;
+  struct Broken {
+    std::uint32_t row;
+    double q, strength;
+    Vec3 direction;
+  };
+  std::vector<Broken> broken;
+  const std::vector<geometry::Mat3> stress = world->particleStress();
+  for (std::uint32_t i = 0; i < p.size(); ++i) {
+    const double d = 2 * p.radius[i];
+    if (d < s_.min_diameter) continue;
+    const sim::PrincipalStresses ps = sim::principalStresses(stress[i]);
+    const double q = sim::octahedralShearStress(ps);
+    if (!(q > 0)) continue;
+    const double strength = s_.strength.strength(d, crusher::uniformFromId(seed_, p.id[i]));
+    if (q > strength) broken.push_back({i, q, strength, ps.minor_direction});
+  }
+  if (broken.empty()) return false;
+  sim::Model model = world->model();
+  sim::WorldState state = world->exportState();
+  std::vector<bool> remove(p.size(), false);
+  for (const Broken& b : broken) remove[b.row] = true;
+  state = sim::withoutBalls(std::move(state), remove);
+  std::vector<std::uint32_t> rows;
+  const std::size_t first_event = events_.size();
+  for (const Broken& b : broken) {
+    const std::uint32_t i = b.row;
+    BreakageEvent e{world->time(), p.id[i], 2 * p.radius[i], b.q, b.strength, {}, 0};
+    for (const crusher::FragmentBall& f :
+         crusher::splitBall(p.position[i], p.radius[i], p.mass[i], b.direction, s_.mode, s_.offsets)) {
+      const int material = fragmentMaterial(model, p.material[i], 2 * f.radius);
+      rows.push_back(appendBall(state.particles, f.position, p.velocity[i], p.omega[i], f.radius, f.mass, material,
+                                next_id_));
+      e.fragments.push_back(next_id_++);
+    }
+    events_.push_back(std::move(e));
+  }
+  const crusher::FreezeResult freeze = crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads);
+  for (std::size_t k = first_event; k < events_.size(); ++k) events_[k].freeze_cycles = freeze.cycles;
+  fragments_created_ += rows.size();
+  ++freezes_;
+  freeze_cycles_ += freeze.cycles;
+  max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
+  world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
+  return true;
+}
+
+nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, const std::filesystem::path& out_dir) const {
+  // Broken balls by the product's sieve classes (parent diameter).
+  std::vector<double> edges{0};
+  edges.insert(edges.end(), sieves_mm.begin(), sieves_mm.end());
+  nlohmann::json by_size = nlohmann::json::array();
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const double lo = edges[k], hi = k + 1 < edges.size() ? edges[k + 1] : std::numeric_limits<double>::infinity();
+    std::size_t n = 0;
+    for (const BreakageEvent& e : events_)
+      if (e.diameter * 1e3 >= lo && e.diameter * 1e3 < hi) ++n;
+    by_size.push_back({{"from_mm", lo}, {"to_mm", std::isfinite(hi) ? nlohmann::json(hi) : nlohmann::json(nullptr)},
+                       {"broken", n}});
+  }
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles\n";
+  for (const BreakageEvent& e : events_) {
+    csv << e.time << ',' << e.parent << ',' << e.diameter * 1e3 << ',' << e.q * 1e-6 << ',' << e.strength * 1e-6 << ','
+        << (s_.mode == crusher::SplitMode::Triple ? "triple" : "equal") << ',';
+    for (std::size_t k = 0; k < e.fragments.size(); ++k) csv << (k ? ";" : "") << e.fragments[k];
+    csv << ',' << e.freeze_cycles << '\n';
+  }
+  detail::writeAtomically(out_dir / "breakage.csv", csv.str());
+  nlohmann::json b;
+  b["events"] = events_.size();
+  b["fragments_created"] = fragments_created_;
+  b["broken_by_size"] = by_size;
+  b["freezes"] = freezes_;
+  b["freeze_cycles"] = freeze_cycles_;
+  b["max_freeze_cycles"] = max_freeze_cycles_;
+  b["mode"] = s_.mode == crusher::SplitMode::Triple ? "triple" : "equal";
+  b["offsets"] = s_.offsets;
+  b["strength"] = {{"q_ref_MPa", s_.strength.q_ref * 1e-6}, {"d_ref_mm", s_.strength.d_ref * 1e3},
+                   {"size_exponent", s_.strength.size_exponent}, {"weibull_modulus", s_.strength.weibull_modulus},
+                   {"min_diameter_mm", s_.min_diameter * 1e3}};
+  b["method"] = "every check_interval a ball of at least min_diameter whose octahedral shear stress q exceeds its "
+                "strength q0(d) (-ln U)^(1/m) (U from the seed and its id) is replaced by fragments inside it along "
+                "its minor principal stress; a freeze (own clock, walls held) eases them apart (breakage.csv)";
+  return b;
+}
+
+}  // namespace rocklab::experiments
