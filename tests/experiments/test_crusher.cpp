@@ -159,6 +159,9 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
   const auto& psd = c["psd"];
   CHECK(psd.front()["passing"] == 0.0);  // 2 mm: nothing finer
   CHECK(psd.back()["passing"] == 1.0);   // 31.5 mm: everything
+  // Every ball discharged whole: the product's curve is the feed's, and both are drawn.
+  CHECK(c["feed_psd"] == psd);
+  CHECK(fs::exists(out / "product_size.png"));
   const std::string product = test::slurp(out / "product.csv");
   CHECK(std::count(product.begin(), product.end(), '\n') == 7);  // header + 6 balls
   CHECK(fs::exists(out / "vtk/walls.pvd"));

@@ -279,6 +279,10 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
       CHECK(c["discharged_balls"] == 6 + 2 * b["events"].get<int>());
       CHECK(c["empty"] == true);
       CHECK(c["psd"][2]["passing"].get<double>() > 0);  // fragments finer than 5.6 mm in the product
+      // The product is finer than the feed on every sieve (breakage only makes balls smaller).
+      for (std::size_t k = 0; k < c["psd"].size(); ++k)
+        CHECK(c["psd"][k]["passing"].get<double>() >= c["feed_psd"][k]["passing"].get<double>());
+      CHECK(c["feed_psd"][2]["passing"] == 0.0);  // the feed (8-9 mm) has nothing finer than 5.6 mm
     }
     const auto& balance = b["mass_balance"];
     CHECK(balance["feed_kg"].get<double>() ==

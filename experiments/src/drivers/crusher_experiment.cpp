@@ -17,6 +17,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "analysis/plot.h"
 #include "common/atomic_file.h"
 
 namespace rocklab::experiments {
@@ -41,7 +42,10 @@ class CrusherRunExperiment final : public Experiment {
         throw std::runtime_error("experiment.type = \"crusher\" takes spheres only (the PBM feed); the scene has clumps");
       every_ = stepsIn(e_.sample_interval, world->dt());
       feed_count_ = p.size();
-      for (std::size_t i = 0; i < p.size(); ++i) feed_mass_ += p.mass[i];
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        feed_mass_ += p.mass[i];
+        feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i]});
+      }
       chamber_mass_ = feed_mass_;
       if (e_.breakage.enabled) breakage_.start(*world, e_.sample_interval);
     }
@@ -79,13 +83,13 @@ class CrusherRunExperiment final : public Experiment {
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override {
     double product_mass = 0;
     for (const ProductBall& b : product_) product_mass += b.mass;
-    nlohmann::json psd = nlohmann::json::array();
-    for (const double sieve : e_.sieves_mm) {
-      double passing = 0;
-      for (const ProductBall& b : product_)
-        if (b.diameter * 1e3 < sieve) passing += b.mass;
-      psd.push_back({{"size_mm", sieve}, {"passing", product_mass > 0 ? passing / product_mass : 0.0}});
+    const std::vector<double> product_passing = passingOf(product_), feed_passing = passingOf(feed_);
+    nlohmann::json psd = nlohmann::json::array(), feed_psd = nlohmann::json::array();
+    for (std::size_t k = 0; k < e_.sieves_mm.size(); ++k) {
+      psd.push_back({{"size_mm", e_.sieves_mm[k]}, {"passing", product_passing[k]}});
+      feed_psd.push_back({{"size_mm", e_.sieves_mm[k]}, {"passing", feed_passing[k]}});
     }
+    writeProductCurves(product_passing, feed_passing, out_dir, log);
     std::ostringstream csv;
     csv.precision(17);
     csv << "id,time_s,diameter_mm,mass_kg\n";
@@ -101,6 +105,7 @@ class CrusherRunExperiment final : public Experiment {
     c["empty"] = chamber_mass_ == 0;
     c["discharge_height_m"] = e_.discharge_height;
     c["psd"] = psd;
+    c["feed_psd"] = feed_psd;
     c["method"] = "a ball whose centre is below discharge_height is product: removed, its diameter and mass recorded "
                   "(product.csv); psd = mass fraction of the product finer than each sieve size";
     c["in_chamber_mass_kg"] = chamber_mass_;
@@ -129,7 +134,45 @@ class CrusherRunExperiment final : public Experiment {
   double feed_mass_ = 0;
   double chamber_mass_ = 0;  // kg still in the run, updated at every discharge and breakage
   std::vector<ProductBall> product_;
+  std::vector<ProductBall> feed_;  // the balls at the start (time 0), for the feed's curve
   CrusherBreakage breakage_;
+
+  /// Mass fraction of `balls` finer than each sieve (0 for no balls).
+  std::vector<double> passingOf(const std::vector<ProductBall>& balls) const {
+    double total = 0;
+    for (const ProductBall& b : balls) total += b.mass;
+    std::vector<double> passing;
+    for (const double sieve : e_.sieves_mm) {
+      double finer = 0;
+      for (const ProductBall& b : balls)
+        if (b.diameter * 1e3 < sieve) finer += b.mass;
+      passing.push_back(total > 0 ? finer / total : 0.0);
+    }
+    return passing;
+  }
+
+  /// product_size.png: cumulative mass percent passing against the sieve size (log
+  /// axis, as a sieve chart), the product beside the feed; no product, no curve.
+  void writeProductCurves(const std::vector<double>& product, const std::vector<double>& feed,
+                          const std::filesystem::path& out_dir, std::ostream& log) const {
+    PlotSpec spec;
+    spec.title = "Product size distribution (" + std::to_string(product_.size()) + " balls discharged)";
+    spec.x_label = "sieve size (mm)";
+    spec.y_label = "cumulative mass passing (%)";
+    spec.log_x = true;
+    spec.y_range = std::pair{0.0, 100.0};
+    PlotSeries f{"feed", e_.sieves_mm, {}, PlotSeries::Style::LinePoints};
+    PlotSeries p{"product", product_.empty() ? std::vector<double>{} : e_.sieves_mm, {}, PlotSeries::Style::LinePoints};
+    for (const double v : feed) f.y.push_back(100 * v);
+    if (!product_.empty())
+      for (const double v : product) p.y.push_back(100 * v);
+    spec.series = {p, f};
+    try {
+      writePlot(spec, out_dir / "product_size.png");
+    } catch (const std::exception& e) {
+      log << "crusher: no product curve (" << e.what() << ")\n";
+    }
+  }
 
   static double massOf(const sim::ParticleState& p) {
     double m = 0;
