@@ -22,7 +22,12 @@ TriangleMesh importMesh(const std::string& path, double scale) {
                 aiProcess_PreTransformVertices);
   if (!scene || !scene->mRootNode)
     throw MeshImportError("cannot read mesh '" + path + "': " + importer.GetErrorString());
-  TriangleMesh mesh = detail::trianglesOf(*scene, scale);
+  TriangleMesh mesh;
+  try {
+    mesh = detail::trianglesOf(*scene, scale);
+  } catch (const detail::BadFaceIndex& e) {
+    throw MeshImportError("cannot read mesh '" + path + "': " + e.what());
+  }
   if (mesh.triangles.empty())
     throw MeshImportError("mesh '" + path + "' contains no triangles");
   return mesh;

@@ -84,3 +84,16 @@ TEST_CASE("a mesh file whose counts disagree with its contents is refused before
   }
   fs::remove_all(scratch());
 }
+
+TEST_CASE("a face index past the vertices that the pre-check misses is refused after assimp reads it", "[mesh]") {
+  // Found by fuzz_mesh (tests/fuzz/regressions/mesh/ply-face-index-past-the-vertices):
+  // the last row lacks its line end, the pre-check counts it as a good face, and
+  // assimp reads vertex 11 from it; the triangles were then indexed past the
+  // vertices (a heap overflow under ASan).
+  const fs::path file = write("eof-row.ply", ply(4, 4, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 00 0 1\n3 0 2 1"));
+  CHECK(meshFileProblem(file.string()).empty());
+  const auto says = Contains(file.string()) && Contains("face 3 refers to vertex 11, but the vertices are 0 to 3");
+  CHECK_THROWS_WITH(rocklab::geometry::readMeshFile(file.string(), 1.0), says);
+  CHECK_THROWS_WITH(rocklab::geometry::importMesh(file.string(), 1.0), says);
+  fs::remove_all(scratch());
+}
