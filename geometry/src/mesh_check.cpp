@@ -82,7 +82,10 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
     throw MeshCheckError("mesh file '" + path + "' cannot be read: " + problem);
   Assimp::Importer importer;
   // No JoinIdenticalVertices here: welding is done below across all meshes of the file.
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices);
+  // ValidateDataStructure first: assimp's own check of what its reader made (a face
+  // index past the vertices, from a damaged file) before any step uses it.
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_PreTransformVertices);
   if (!scene || !scene->mRootNode)
     throw MeshCheckError("mesh file '" + path + "' cannot be read (STL ascii/binary, PLY and OBJ are supported): " +
                          importer.GetErrorString());

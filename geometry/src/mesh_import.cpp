@@ -16,10 +16,12 @@ TriangleMesh importMesh(const std::string& path, double scale) {
     throw MeshImportError("cannot read mesh '" + path + "': " + problem);
   Assimp::Importer importer;
   // Per-face normals keep STL vertices apart; drop normals so that welding works.
+  // ValidateDataStructure first: assimp's own check of what its reader made (a face
+  // index past the vertices would otherwise reach JoinIdenticalVertices).
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
   const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices |
-                aiProcess_PreTransformVertices);
+      path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_RemoveComponent |
+                aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices);
   if (!scene || !scene->mRootNode)
     throw MeshImportError("cannot read mesh '" + path + "': " + importer.GetErrorString());
   TriangleMesh mesh;
