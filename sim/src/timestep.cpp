@@ -136,9 +136,16 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, 
   // Damped stability limit (see dampedStabilityLimit). Each ball's inverse masses
   // of the normal and the sticking-shear mode at a contact: 1/m + e^2/I with e the
   // lever of the force about the centre (0 normal, R shear for a sphere; clump
-  // members: their offset, and offset + R). Partners: a ball like this one, the
-  // lightest and the heaviest ball (the average-mass dashpot of a fragment on a
-  // rock is the hardest), or a wall (immovable, dashpot on the ball's mass).
+  // members: their offset, and offset + R). Partners: for each material present,
+  // the lightest and the heaviest ball of that material, on the stiffness of that
+  // pair of materials (a ball of one material never meets another's spring: a
+  // 9 mg fragment on its soft class stiffness is not damped like a rock on
+  // rock), or a wall (immovable, dashpot on the ball's mass). A partner of a mass
+  // between the two is never harder: with the reduced-mass dashpot both the
+  // damping rate and the spring rate fall as the partner gets heavier, with the
+  // average-mass one the damping rate falls then rises (one minimum, at twice the
+  // ball's mass) while the spring rate falls, and the limit over a mass range is
+  // then at one of its ends.
   const ContactModel& cm = model.contact;
   const bool damped = cm.damping_normal > 0 || cm.damping_shear > 0;
   double damped_limit = inf;
@@ -153,13 +160,16 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, 
   for (std::size_t m = 0; m < clumps.member_ball.size(); ++m)
     lever[clumps.member_ball[m]] += clumps.member_offset[m].norm();
 
-  std::size_t light = 0, heavy = 0;
+  // The lightest and the heaviest ball of each material (rows; none: npos).
+  constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> light(model.materials.size(), npos), heavy(model.materials.size(), npos);
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const double m = particles.mass[i], r = particles.radius[i], inv_i = particles.inv_inertia[i];
     const double offset = lever[i] - r;
     body[i] = {m, 1.0 / m + offset * offset * inv_i, 1.0 / m + lever[i] * lever[i] * inv_i};
-    if (m < particles.mass[light]) light = i;
-    if (m > particles.mass[heavy]) heavy = i;
+    const auto mat = static_cast<std::size_t>(particles.material[i]);
+    if (light[mat] == npos || m < particles.mass[light[mat]]) light[mat] = i;
+    if (heavy[mat] == npos || m > particles.mass[heavy[mat]]) heavy[mat] = i;
   }
   auto dampedModes = [&](double kn, double ks, const Body& self, const Body* b) {
     const double inv_n = self.inv_n + (b ? b->inv_n : 0.0), inv_t = self.inv_t + (b ? b->inv_t : 0.0);
@@ -179,7 +189,8 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, 
     const Material& mi = model.materials[particles.material[i]];
     const double m = particles.mass[i], r = particles.radius[i], arm = lever[i];
     const double inertia = 1.0 / particles.inv_inertia[i];
-    auto consider = [&](const PairProps& p, double m_star, bool wall) {
+    // partner_material: the other ball's material (-1: a wall).
+    auto consider = [&](const PairProps& p, double m_star, int partner_material) {
       double kn = p.kn, ks = p.ks;
       if (hertz) {
         // Tangent stiffnesses at the deepest overlap of an impact at `v`.
@@ -192,10 +203,13 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, 
       a.spring_translational = std::min(a.spring_translational, std::sqrt(m / kn));
       a.spring_rotational = std::min(a.spring_rotational, std::sqrt(inertia / (ks * arm * arm)));
       if (damped) {
-        if (wall) {
+        if (partner_material < 0) {
           dampedModes(kn, ks, body[i], nullptr);
         } else {
-          for (std::size_t partner : {i, light, heavy}) dampedModes(kn, ks, body[i], &body[partner]);
+          const auto k = static_cast<std::size_t>(partner_material);
+          for (std::size_t partner : {light[k], heavy[k]}) dampedModes(kn, ks, body[i], &body[partner]);
+          // A ball like this one (a clump's lever is not its mass: not bounded by the ends).
+          if (k == static_cast<std::size_t>(particles.material[i])) dampedModes(kn, ks, body[i], &body[i]);
         }
       }
       if (m < lightest || (m == lightest && kn > lightest_k)) {
@@ -204,8 +218,8 @@ TimestepAudit auditTimestep(const Model& model, const ParticleState& particles, 
       }
     };
     for (std::size_t k = 0; k < model.materials.size(); ++k)
-      if (ball_material[k]) consider(detail::ballBallProps(mi, model.materials[k]), 0.5 * m, false);
-    for (const Wall& w : model.walls) consider(detail::ballWallProps(mi, model.materials[w.material]), m, true);
+      if (ball_material[k]) consider(detail::ballBallProps(mi, model.materials[k]), 0.5 * m, static_cast<int>(k));
+    for (const Wall& w : model.walls) consider(detail::ballWallProps(mi, model.materials[w.material]), m, -1);
     if (mi.shear_modulus > 0)
       rayleigh = std::min(rayleigh, rayleighStep(r, mi.density, mi.shear_modulus, mi.poisson));
   }

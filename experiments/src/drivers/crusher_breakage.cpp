@@ -111,6 +111,10 @@ void CrusherBreakage::start(const sim::World& world, double sample_interval) {
   const std::vector<double> fractions = crusher::massFractions(s_.mode);
   const double d = s_.min_diameter * std::cbrt(*std::min_element(fractions.begin(), fractions.end()));
   sim::Model probe = model;
+  // The probe's automatic step is what is asked for: a scene's own timestep.dt is
+  // compared below, with the message naming the breakage's keys (the engine's
+  // audit would refuse it first, naming only timestep.dt).
+  probe.timestep.dt = 0.0;
   sim::ParticleState balls = p;
   CrusherBreakage scratch = *this;  // the probe's materials must not enter the run's table
   for (const int material : std::set<int>(p.material.begin(), p.material.end())) {
