@@ -245,6 +245,7 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
   CHECK(test::cliLogged(args, log) == 2);
   CHECK_THAT(log, Contains("smallest fragment") && Contains("timestep.dt") &&
                       Contains("experiment.breakage.min_diameter"));
+  CHECK_THAT(log, Contains("experiment \"crusher\": "));  // whose settings, not "phase switch"
   // The same with the step set by the scene (allowed for its balls): the breakage's
   // message, not the engine's audit naming only timestep.dt.
   args.insert(args.end(), {"--set", "timestep.dt=1e-6", "--overwrite"});

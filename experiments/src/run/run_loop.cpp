@@ -117,9 +117,10 @@ class RunLoop {
     } catch (const sim::WatchdogError& e) {
       stopWith("stopped_by_watchdog", e.what(), kExitWatchdog);
     } catch (const std::invalid_argument& e) {
-      // A phase switch of the experiment made an unusable world (e.g. a wall
-      // setting that only fails once the wall is placed): stop, keep the outputs.
-      stopWith("failed", std::string("experiment phase switch: ") + e.what(), kExitBadInput);
+      // The experiment found its settings unusable once running (a wall setting that
+      // only fails once the wall is placed, a step too long for the crusher's smallest
+      // fragment): bad input, named by the message; stop, keep the outputs.
+      stopWith("failed", "experiment \"" + scene_.experiment_type + "\": " + e.what(), kExitBadInput);
     } catch (const std::exception& e) {
       // Anything else the experiment or an output met (a photograph it cannot read, a
       // full disk): stop with the reason instead of aborting; outputs so far are kept.
