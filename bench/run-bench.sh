@@ -11,7 +11,9 @@
 #          the same frames) or all (default)
 #   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
 #   OUTDIR logs and results (default: a new temporary directory)
-# Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install liggghts`.
+# Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install
+# --no-install-recommends liggghts` (with its recommends apt removes libvtk9-dev for
+# ParaView, and rocklab no longer configures).
 # Both engines run the same lattice, walls, contact law (linear, 1e9 N/m per contact,
 # friction 0.37, tangential history, no damping), dt = 1e-6 s, skin 2 mm and step count.
 set -euo pipefail
