@@ -1,4 +1,5 @@
-// Removal of bodies from a saved state (see withoutBalls in world.h).
+// Removal of bodies from a saved state (see withoutBalls in world.h), and free
+// spheres added to one.
 #include <cstdint>
 #include <stdexcept>
 
@@ -90,6 +91,29 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
     bonds.b[e] = new_index[bonds.b[e]];
   }
   return state;
+}
+
+void setFreeSphereMass(ParticleState& p, std::size_t i, double mass) {
+  const double r = p.radius[i];
+  p.mass[i] = mass;
+  p.inv_mass[i] = 1.0 / mass;
+  p.inv_inertia[i] = 1.0 / (0.4 * mass * r * r);  // Eq 2-8
+}
+
+std::uint32_t appendFreeSphere(ParticleState& p, const SphereSpec& s, double mass, std::uint64_t id) {
+  const std::size_t i = p.size();
+#define ROCKLAB_GROW(type, name, unit, meaning) p.name.emplace_back();
+  ROCKLAB_BALL_FIELDS(ROCKLAB_GROW)
+#undef ROCKLAB_GROW
+  if (!p.clump.empty()) p.clump.push_back(-1);
+  p.position[i] = s.position;
+  p.velocity[i] = s.velocity;
+  p.omega[i] = s.omega;
+  p.radius[i] = s.radius;
+  p.material[i] = s.material;
+  p.id[i] = id;
+  setFreeSphereMass(p, i, mass);
+  return static_cast<std::uint32_t>(i);
 }
 
 }  // namespace rocklab::sim

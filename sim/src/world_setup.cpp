@@ -1,7 +1,6 @@
 #include "world_impl.h"
 
 #include <cmath>
-#include <numbers>
 #include <sstream>
 
 #include "rigid_body.h"
@@ -178,23 +177,12 @@ World::World(Model model, const std::vector<SphereSpec>& spheres, const std::vec
   std::size_t members = 0;
   for (const ClumpSpec& c : clumps) members += c.members.size();
   const std::size_t n = spheres.size() + members;
+  // Velocities at t = 0: the first kick is a half kick.
+  for (std::size_t i = 0; i < spheres.size(); ++i)
+    appendFreeSphere(p, spheres[i], sphereMass(w.model.materials[spheres[i].material].density, spheres[i].radius), i);
 #define ROCKLAB_RESIZE(type, name, unit, meaning) p.name.resize(n);
   ROCKLAB_BALL_FIELDS(ROCKLAB_RESIZE)
 #undef ROCKLAB_RESIZE
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    const SphereSpec& s = spheres[i];
-    const double r = s.radius;
-    const double m = w.model.materials[s.material].density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    p.position[i] = s.position;
-    p.velocity[i] = s.velocity;  // at t = 0; the first kick is a half kick
-    p.omega[i] = s.omega;
-    p.radius[i] = r;
-    p.mass[i] = m;
-    p.inv_mass[i] = 1.0 / m;
-    p.inv_inertia[i] = 1.0 / (0.4 * m * r * r);  // Eq 2-8
-    p.material[i] = s.material;
-    p.id[i] = i;
-  }
   if (!clumps.empty()) {
     ClumpState& k = p.clumps;
     p.clump.assign(n, -1);

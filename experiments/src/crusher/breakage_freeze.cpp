@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -95,10 +94,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
   sim::ParticleState& p = frozen.particles;
   const sim::Model m = freezeModel(model, state.time, p.material, fragments, s);
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double r = p.radius[i];
-    p.mass[i] = s.density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    p.inv_mass[i] = 1.0 / p.mass[i];
-    p.inv_inertia[i] = 1.0 / (0.4 * p.mass[i] * r * r);
+    sim::setFreeSphereMass(p, i, sim::sphereMass(s.density, p.radius[i]));
     p.velocity[i] = p.omega[i] = Vec3::Zero();
   }
   FreezeResult result;

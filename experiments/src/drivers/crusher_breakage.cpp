@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -11,6 +10,7 @@
 #include "common/atomic_file.h"
 #include "rocklab/sim/particle_stress.h"
 #include "rocklab/sim/timestep.h"
+#include "rocklab/sim/world.h"
 
 namespace rocklab::experiments {
 
@@ -47,25 +47,6 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
 }
 
 namespace {
-
-/// Appends a free sphere to `p` (the per-ball fields of particles.h); returns its row.
-std::uint32_t appendBall(sim::ParticleState& p, const Vec3& position, const Vec3& velocity, const Vec3& omega,
-                         double radius, double mass, int material, std::uint64_t id) {
-  p.position.push_back(position);
-  p.velocity.push_back(velocity);
-  p.omega.push_back(omega);
-  p.radius.push_back(radius);
-  p.inv_mass.push_back(1.0 / mass);
-  p.inv_inertia.push_back(1.0 / (0.4 * mass * radius * radius));  // Eq 2-8
-  p.material.push_back(material);
-  p.mass.push_back(mass);
-  p.id.push_back(id);
-  return static_cast<std::uint32_t>(p.size() - 1);
-}
-
-double ballVolume(double radius) {
-  return 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
-}
 
 std::string mm(double metres) {
   std::ostringstream s;
@@ -119,8 +100,9 @@ void CrusherBreakage::start(const sim::World& world, double sample_interval) {
   CrusherBreakage scratch = *this;  // the probe's materials must not enter the run's table
   for (const int material : std::set<int>(p.material.begin(), p.material.end())) {
     const int m = scratch.fragmentMaterial(probe, material, d);
-    appendBall(balls, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, model.materials[material].density * ballVolume(d / 2),
-               m, std::numeric_limits<std::uint64_t>::max() - static_cast<std::uint64_t>(material));
+    sim::appendFreeSphere(balls, {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), d / 2, m},
+                          sim::sphereMass(model.materials[material].density, d / 2),
+                          std::numeric_limits<std::uint64_t>::max() - static_cast<std::uint64_t>(material));
   }
   if (balls.size() == p.size()) return;
   const sim::TimestepAudit audit = sim::auditTimestep(probe, balls);
@@ -170,8 +152,8 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     for (const crusher::FragmentBall& f :
          crusher::splitBall(p.position[i], p.radius[i], p.mass[i], b.direction, s_.mode, s_.offsets)) {
       const int material = fragmentMaterial(model, p.material[i], 2 * f.radius);
-      rows.push_back(appendBall(state.particles, f.position, p.velocity[i], p.omega[i], f.radius, f.mass, material,
-                                next_id_));
+      rows.push_back(
+          sim::appendFreeSphere(state.particles, {f.position, p.velocity[i], p.omega[i], f.radius, material}, f.mass, next_id_));
       e.fragments.push_back(next_id_++);
     }
     events_.push_back(std::move(e));

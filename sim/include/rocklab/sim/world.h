@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -170,6 +171,20 @@ class World {
 /// without them: this is how experiments drop discharged pebbles or the clumps
 /// cut by a plate added after deposition.
 WorldState withoutBalls(WorldState state, std::vector<bool> remove);
+
+/// Mass (kg) of a solid sphere of `radius` (m) at `density` (kg/m^3).
+inline double sphereMass(double density, double radius) {
+  return density * 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+}
+
+/// Sets ball `i`'s mass and what follows from it for a free sphere: 1/m and
+/// 1/(2/5 m R^2) (Eq 2-8).
+void setFreeSphereMass(ParticleState& particles, std::size_t i, double mass);
+
+/// Appends a free sphere (no clump) of `mass` and `id` to the balls, the way the
+/// World builds its spheres; returns its row. Experiments add balls to a saved
+/// state with it (the crusher's fragments).
+std::uint32_t appendFreeSphere(ParticleState& particles, const SphereSpec& sphere, double mass, std::uint64_t id);
 
 /// Validates a model, its spheres and clumps; returns "" or a message naming the field.
 std::string validateModel(const Model& model, const std::vector<SphereSpec>& spheres,
