@@ -38,6 +38,9 @@ enum class SplitMode {
   Equal,   // two halves
 };
 
+/// The scene's name of `mode` (experiment.breakage.mode).
+inline const char* modeName(SplitMode mode) { return mode == SplitMode::Triple ? "triple" : "equal"; }
+
 /// Mass fractions of the fragments of `mode`, in the order of their offsets.
 std::vector<double> massFractions(SplitMode mode);
 /// The reference's [X] placement, in parent radii along the minor principal

@@ -186,7 +186,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles\n";
   for (const BreakageEvent& e : events_) {
     csv << e.time << ',' << e.parent << ',' << e.diameter * 1e3 << ',' << e.q * 1e-6 << ',' << e.strength * 1e-6 << ','
-        << (s_.mode == crusher::SplitMode::Triple ? "triple" : "equal") << ',';
+        << crusher::modeName(s_.mode) << ',';
     for (std::size_t k = 0; k < e.fragments.size(); ++k) csv << (k ? ";" : "") << e.fragments[k];
     csv << ',' << e.freeze_cycles << '\n';
   }
@@ -198,7 +198,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freezes"] = freezes_;
   b["freeze_cycles"] = freeze_cycles_;
   b["max_freeze_cycles"] = max_freeze_cycles_;
-  b["mode"] = s_.mode == crusher::SplitMode::Triple ? "triple" : "equal";
+  b["mode"] = crusher::modeName(s_.mode);
   b["offsets"] = s_.offsets;
   b["strength"] = {{"q_ref_MPa", s_.strength.q_ref * 1e-6}, {"d_ref_mm", s_.strength.d_ref * 1e3},
                    {"size_exponent", s_.strength.size_exponent}, {"weibull_modulus", s_.strength.weibull_modulus},

@@ -41,12 +41,8 @@ class CrusherRunExperiment final : public Experiment {
       if (p.clumps.size() > 0)
         throw std::runtime_error("experiment.type = \"crusher\" takes spheres only (the PBM feed); the scene has clumps");
       every_ = stepsIn(e_.sample_interval, world->dt());
-      feed_count_ = p.size();
-      for (std::size_t i = 0; i < p.size(); ++i) {
-        feed_mass_ += p.mass[i];
-        feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i]});
-      }
-      chamber_mass_ = feed_mass_;
+      for (std::size_t i = 0; i < p.size(); ++i) feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i]});
+      chamber_mass_ = massOf(feed_);
       if (e_.breakage.enabled) breakage_.start(*world, e_.sample_interval);
     }
     if (world->particles().size() == 0) return false;  // the chamber is empty
@@ -81,8 +77,7 @@ class CrusherRunExperiment final : public Experiment {
   }
 
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override {
-    double product_mass = 0;
-    for (const ProductBall& b : product_) product_mass += b.mass;
+    const double product_mass = massOf(product_), feed_mass = massOf(feed_);
     const std::vector<double> product_passing = passingOf(product_), feed_passing = passingOf(feed_);
     nlohmann::json psd = nlohmann::json::array(), feed_psd = nlohmann::json::array();
     for (std::size_t k = 0; k < e_.sieves_mm.size(); ++k) {
@@ -96,8 +91,8 @@ class CrusherRunExperiment final : public Experiment {
     for (const ProductBall& b : product_) csv << b.id << ',' << b.time << ',' << b.diameter * 1e3 << ',' << b.mass << '\n';
     detail::writeAtomically(out_dir / "product.csv", csv.str());
     nlohmann::json c;
-    c["feed_balls"] = feed_count_;
-    c["feed_mass_kg"] = feed_mass_;
+    c["feed_balls"] = feed_.size();
+    c["feed_mass_kg"] = feed_mass;
     c["discharged_balls"] = product_.size();
     c["discharged_mass_kg"] = product_mass;
     c["first_discharge_s"] = product_.empty() ? nlohmann::json(nullptr) : nlohmann::json(product_.front().time);
@@ -112,14 +107,14 @@ class CrusherRunExperiment final : public Experiment {
     if (e_.breakage.enabled) {
       nlohmann::json b = breakage_.report(e_.sieves_mm, out_dir);
       // Breakage conserves mass to round-off: the feed is the product and what is left.
-      b["mass_balance"] = {{"feed_kg", feed_mass_},
+      b["mass_balance"] = {{"feed_kg", feed_mass},
                            {"product_kg", product_mass},
                            {"in_chamber_kg", chamber_mass_},
-                           {"relative_difference", (feed_mass_ - product_mass - chamber_mass_) / feed_mass_}};
+                           {"relative_difference", (feed_mass - product_mass - chamber_mass_) / feed_mass}};
       c["breakage"] = b;
     }
     r["crusher"] = c;
-    log << "crusher: " << product_.size() << " balls discharged (" << product_mass << " kg of " << feed_mass_
+    log << "crusher: " << product_.size() << " balls discharged (" << product_mass << " kg of " << feed_mass
         << " kg fed)";
     if (e_.breakage.enabled)
       log << ", " << breakage_.events().size() << " broke into " << breakage_.fragmentsCreated() << " fragments";
@@ -130,17 +125,20 @@ class CrusherRunExperiment final : public Experiment {
   CrusherRunSettings e_;
   bool started_ = false;
   std::uint64_t every_ = 1;
-  std::size_t feed_count_ = 0;
-  double feed_mass_ = 0;
   double chamber_mass_ = 0;  // kg still in the run, updated at every discharge and breakage
   std::vector<ProductBall> product_;
   std::vector<ProductBall> feed_;  // the balls at the start (time 0), for the feed's curve
   CrusherBreakage breakage_;
 
+  static double massOf(const std::vector<ProductBall>& balls) {
+    double m = 0;
+    for (const ProductBall& b : balls) m += b.mass;
+    return m;
+  }
+
   /// Mass fraction of `balls` finer than each sieve (0 for no balls).
   std::vector<double> passingOf(const std::vector<ProductBall>& balls) const {
-    double total = 0;
-    for (const ProductBall& b : balls) total += b.mass;
+    const double total = massOf(balls);
     std::vector<double> passing;
     for (const double sieve : e_.sieves_mm) {
       double finer = 0;
