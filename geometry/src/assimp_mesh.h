@@ -4,7 +4,6 @@
 // importMesh (mesh walls) and readMeshFile (particle scans). Internal.
 #include <cstdint>
 #include <filesystem>
-#include <stdexcept>
 #include <string>
 
 #include <assimp/scene.h>
@@ -22,12 +21,8 @@ inline std::string notAFile(const std::string& path) {
   return {};
 }
 
-/// Thrown by trianglesOf when a face names a vertex its mesh does not have (a
-/// damaged file that assimp still reads); the callers add the file's name.
-struct BadFaceIndex : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
+/// The triangles of an assimp scene. Its readers run aiProcess_ValidateDataStructure
+/// first, so every face index is within its mesh's vertices here.
 inline TriangleMesh trianglesOf(const aiScene& scene, double scale) {
   TriangleMesh mesh;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
@@ -40,13 +35,6 @@ inline TriangleMesh trianglesOf(const aiScene& scene, double scale) {
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines carry no surface
-      for (unsigned k = 0; k < 3; ++k)
-        if (face.mIndices[k] >= am->mNumVertices)
-          throw BadFaceIndex("face " + std::to_string(f) + (scene.mNumMeshes > 1 ? " of mesh " + std::to_string(m) : "") +
-                             " refers to vertex " + std::to_string(face.mIndices[k]) +
-                             (am->mNumVertices == 0 ? std::string(", but there are no vertices")
-                                                    : ", but the vertices are 0 to " +
-                                                          std::to_string(am->mNumVertices - 1)));
       mesh.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
     }
   }

@@ -89,12 +89,7 @@ TriangleMesh readMeshFile(const std::string& path, double scale) {
   if (!scene || !scene->mRootNode)
     throw MeshCheckError("mesh file '" + path + "' cannot be read (STL ascii/binary, PLY and OBJ are supported): " +
                          importer.GetErrorString());
-  TriangleMesh soup;
-  try {
-    soup = detail::trianglesOf(*scene, scale);
-  } catch (const detail::BadFaceIndex& e) {
-    throw MeshCheckError("mesh file '" + path + "' cannot be read: " + e.what());
-  }
+  TriangleMesh soup = detail::trianglesOf(*scene, scale);
   if (soup.triangles.empty()) throw MeshCheckError("mesh file '" + path + "' contains no triangles");
   // Before welding: NaN breaks the ordering the weld relies on.
   if (const std::string bad = soup.nonFiniteVertex(); !bad.empty())

@@ -24,12 +24,7 @@ TriangleMesh importMesh(const std::string& path, double scale) {
                 aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices);
   if (!scene || !scene->mRootNode)
     throw MeshImportError("cannot read mesh '" + path + "': " + importer.GetErrorString());
-  TriangleMesh mesh;
-  try {
-    mesh = detail::trianglesOf(*scene, scale);
-  } catch (const detail::BadFaceIndex& e) {
-    throw MeshImportError("cannot read mesh '" + path + "': " + e.what());
-  }
+  TriangleMesh mesh = detail::trianglesOf(*scene, scale);
   if (mesh.triangles.empty())
     throw MeshImportError("mesh '" + path + "' contains no triangles");
   return mesh;
