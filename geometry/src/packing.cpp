@@ -3,6 +3,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "rocklab/geometry/mix64.h"
 #include "sphere_hash_grid.h"
 
 namespace rocklab::geometry {
@@ -29,12 +30,7 @@ std::vector<Vec3> latticePoints(LatticeKind kind, double cell, const Vec3& offse
   return points;
 }
 
-std::uint64_t Rng::next() {
-  std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
+std::uint64_t Rng::next() { return mix64(state_ += kSplitmixGamma); }
 
 double Rng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
 

@@ -1,15 +1,14 @@
 #include "sensor.h"
 
+#include "rocklab/geometry/mix64.h"
+
 namespace rocklab::render::detail {
 
 namespace {
 
 // splitmix64 finaliser: a well-mixed seed from (options seed, frame index).
 std::uint64_t mix(std::uint64_t a, std::uint64_t b) {
-  std::uint64_t z = a ^ (b + 0x9e3779b97f4a7c15ull + (a << 6) + (a >> 2));
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
+  return geometry::mix64(a ^ (b + geometry::kSplitmixGamma + (a << 6) + (a >> 2)));
 }
 
 }  // namespace

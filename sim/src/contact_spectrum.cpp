@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rocklab/geometry/mix64.h"
+
 namespace rocklab::sim::detail {
 
 namespace {
@@ -10,10 +12,7 @@ namespace {
 /// Fixed pseudo-random start in [-1, 1] (splitmix64): the same on every run and
 /// thread count, with a component along every mode.
 double startValue(std::uint64_t k) {
-  std::uint64_t z = (k + 1) * 0x9e3779b97f4a7c15ull;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
+  const std::uint64_t z = geometry::mix64((k + 1) * geometry::kSplitmixGamma);
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 

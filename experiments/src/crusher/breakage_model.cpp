@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "rocklab/geometry/mix64.h"
+
 namespace rocklab::experiments::crusher {
 
 double StrengthLaw::scale(double diameter) const {
@@ -13,20 +15,10 @@ double StrengthLaw::strength(double diameter, double u) const {
   return scale(diameter) * std::pow(-std::log(u), 1.0 / weibull_modulus);
 }
 
-namespace {
-
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-}  // namespace
-
 double uniformFromId(std::uint64_t seed, std::uint64_t id) {
   // Two rounds: the seed's hash keys the id's, so neighbouring seeds and ids give
   // unrelated draws. 53 bits, centred in their cell: never 0 or 1 (-ln U is finite).
+  auto splitmix64 = [](std::uint64_t x) { return geometry::mix64(x + geometry::kSplitmixGamma); };
   const std::uint64_t h = splitmix64(splitmix64(seed) ^ id);
   return (static_cast<double>(h >> 11) + 0.5) * 0x1.0p-53;
 }
