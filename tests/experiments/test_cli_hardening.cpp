@@ -132,6 +132,11 @@ TEST_CASE("an output folder the run cannot write into is refused before the run"
   // As root the permission bits do not bind: the run is made in a child that gives up root.
   const fs::path dir = tempDir("readonly");
   fs::create_directories(dir / "out");
+  // The child, no longer root, must still read the scene wherever the source tree
+  // is (a clone in a 0700 mktemp folder): it runs a readable copy.
+  const fs::path scene = dir / "hopper.toml";
+  fs::copy_file(kHopper, scene);
+  fs::permissions(scene, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
   fs::permissions(dir, fs::perms::owner_all | fs::perms::group_exec | fs::perms::others_exec);
   fs::permissions(dir / "out", fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
                                    fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
@@ -141,7 +146,7 @@ TEST_CASE("an output folder the run cannot write into is refused before the run"
     if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(50);
     std::ostringstream err;
     std::cerr.rdbuf(err.rdbuf());
-    const int code = cli(with({"run", kHopper, "--out", (dir / "out").string()}, kShort));
+    const int code = cli(with({"run", scene.string(), "--out", (dir / "out").string()}, kShort));
     ::_exit(code == 2 && err.str().find("cannot write into output folder") != std::string::npos ? 0 : 40 + code);
   }
   int status = 0;
