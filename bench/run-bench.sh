@@ -3,12 +3,14 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|grid|render|track|all] [small|full] [OUTDIR]
+# Usage: bench/run-bench.sh [settle|dense|grid|render|track|memory|all] [small|full] [OUTDIR]
 #   scene  settle (contact-sparse), dense (contact-rich), grid (7:1 size ratio:
 #          multi-level against single-level neighbour grid, rocklab only), render
 #          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
 #          1280x1024, rocklab only), track (marker detection + linking frames/s on
-#          the same frames) or all (default)
+#          the same frames), memory (rocklab's peak-RSS growth per sphere on settle
+#          and dense, N = 2000 to 54000, one thread, 200 steps: not a timing, so it
+#          may run beside other work) or all (default: every timing, not memory)
 #   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
 #   OUTDIR logs and results (default: a new temporary directory)
 # Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install
@@ -58,6 +60,38 @@ run_peer() {  # scene n procs steps NX NY NZ -> sets pps
   pps=$(echo "$n * $steps / $t" | bc -l)
 }
 
+box_args() {  # box_args scene nx ny nz -> sets args: the lattice counts and the box of bench/liggghts
+  local scene=$1 nx=$2 ny=$3 nz=$4
+  if [ $scene = settle ]; then  # box as in settle.liggghts
+    args=(--set "walls.0.max=[$(calc "$nx*0.0232+0.012"),$(calc "$ny*0.0232+0.012"),$(calc "$nz*0.0232*1.2")]")
+  else                          # box as in dense.liggghts: (N - 0.25) a + 0.01
+    local a=0.0282842712474619
+    args=(--set "walls.0.max=[$(calc "($nx-0.25)*$a+0.01"),$(calc "($ny-0.25)*$a+0.01"),$(calc "($nz+1)*$a")]")
+  fi
+  args+=(--set "particles.0.counts=[$nx,$ny,$nz]")
+}
+
+# Memory: peak-RSS growth per sphere from N = 2000 (removes the fixed cost), one thread.
+if [ "$which_scenes" = memory ]; then
+  printf 'scene,N,steps,peak_rss_bytes,bytes_per_particle_from_2000\n'
+  for scene in settle dense; do
+    case $scene in
+      settle) per=2; specs=("10 10 10" "20 20 20" "30 30 30") ;;
+      dense)  per=4; specs=("10 10 5" "20 20 10" "30 30 15") ;;
+    esac
+    rss_small=""
+    for spec in "${specs[@]}"; do
+      set -- $spec
+      n=$((per * $1 * $2 * $3))
+      box_args $scene $1 $2 $3
+      run_rocklab $scene $n 1 200 "${args[@]}"
+      if [ -z "$rss_small" ]; then rss_small=$rss; n_small=$n; bpp=""; else bpp=$(echo "($rss - $rss_small) / ($n - $n_small)" | bc); fi
+      printf '%s,%d,200,%s,%s\n' $scene $n "$rss" "$bpp"
+    done
+  done
+  exit 0
+fi
+
 printf 'scene,N,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,rocklab_bytes_per_particle,touching_pairs_per_sphere\n'
 for scene in settle dense; do
   [ "$which_scenes" = all ] || [ "$which_scenes" = "$scene" ] || continue
@@ -70,13 +104,7 @@ for scene in settle dense; do
   for spec in "${specs[@]}"; do
     set -- $spec
     nx=$1 ny=$2 nz=$3 steps=$4 n=$((per * $1 * $2 * $3))
-    if [ $scene = settle ]; then  # box as in settle.liggghts
-      box=(--set "walls.0.max=[$(calc "$nx*0.0232+0.012"),$(calc "$ny*0.0232+0.012"),$(calc "$nz*0.0232*1.2")]")
-    else                          # box as in dense.liggghts: (N - 0.25) a + 0.01
-      a=0.0282842712474619
-      box=(--set "walls.0.max=[$(calc "($nx-0.25)*$a+0.01"),$(calc "($ny-0.25)*$a+0.01"),$(calc "($nz+1)*$a")]")
-    fi
-    args=(--set "particles.0.counts=[$nx,$ny,$nz]" "${box[@]}")
+    box_args $scene $nx $ny $nz
     run_rocklab $scene $n 1 "$steps" "${args[@]}"; r1=$ps; rss1=$rss
     run_rocklab $scene $n 2 "$steps" "${args[@]}"; r2=$ps
     run_peer $scene $n 1 "$steps" $nx $ny $nz; l1=$pps

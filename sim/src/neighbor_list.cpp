@@ -96,11 +96,16 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
 
   // Candidate pairs: each ball searches its own level (keeping j > i) and every
   // coarser level (each cross-level pair is found once, by its smaller ball).
+  // One thread writes straight into keys_: a second buffer of 8 bytes a pair
+  // would be kept for the whole run only to be copied once.
   const int nthreads = std::max(1, threads);
-  thread_keys_.resize(nthreads);
+  if (nthreads == 1)
+    thread_keys_.clear();
+  else
+    thread_keys_.resize(nthreads);
 #pragma omp parallel num_threads(nthreads)
   {
-    auto& keys = thread_keys_[omp_get_thread_num()];
+    auto& keys = nthreads == 1 ? keys_ : thread_keys_[omp_get_thread_num()];
     keys.clear();
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
@@ -132,8 +137,10 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
       }
     }
   }
-  keys_.clear();
-  for (auto& k : thread_keys_) keys_.insert(keys_.end(), k.begin(), k.end());
+  if (nthreads > 1) {
+    keys_.clear();
+    for (auto& k : thread_keys_) keys_.insert(keys_.end(), k.begin(), k.end());
+  }
   std::sort(keys_.begin(), keys_.end());
   if (!excluded.empty()) {
     // Both ascending: one merge pass drops the excluded pairs.
@@ -151,12 +158,14 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
   for (std::size_t p = 0; p < keys_.size(); ++p) {
     out.partner[p] = static_cast<std::uint32_t>(keys_[p] & 0xffffffffu);
     ++out.row_offset[(keys_[p] >> 32) + 1];
-    ++out.col_offset[out.partner[p] + 1];
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    out.row_offset[i + 1] += out.row_offset[i];
-    out.col_offset[i + 1] += out.col_offset[i];
+  for (std::size_t i = 0; i < n; ++i) out.row_offset[i + 1] += out.row_offset[i];
+  if (nthreads == 1) {  // only the threads' hand-over reads the transpose
+    out.col_offset.clear();
+    return;
   }
+  for (std::size_t p = 0; p < keys_.size(); ++p) ++out.col_offset[out.partner[p] + 1];
+  for (std::size_t i = 0; i < n; ++i) out.col_offset[i + 1] += out.col_offset[i];
   out.col_pair.resize(keys_.size());
   std::vector<std::uint32_t> fill(out.col_offset.begin(), out.col_offset.end() - 1);
   for (std::size_t p = 0; p < keys_.size(); ++p)

@@ -17,7 +17,8 @@ using geometry::Vec3;
 /// Pairs in compressed rows: row i lists partners j > i in ascending order.
 /// `col_*` is the transpose: for ball j, the indices of the pairs (i, j), i < j,
 /// in ascending i. Both orders are canonical, so sums over them are the same
-/// whatever the number of threads and whenever the list was rebuilt.
+/// whatever the number of threads and whenever the list was rebuilt. The
+/// transpose is built only for more than one thread (empty otherwise).
 struct PairList {
   std::vector<std::uint32_t> row_offset;  // [n+1]
   std::vector<std::uint32_t> partner;     // [pairs] j of each pair

@@ -219,7 +219,6 @@ struct World::Impl {
     std::vector<double> wall_work, wall_work_gross;
     std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
     detail::SpectrumEstimate spectrum;      // fastest network mode, kept between checks
-    detail::ContactNetwork network;         // rebuilt at every check (buffers reused)
   } guard;
 
   // --- relaxation of initial overlaps (Model::relaxation); empty when off or done
@@ -333,7 +332,9 @@ struct World::Impl {
   void checkEnergy(const Energy& e);
   bool energyCheckApplies() const;
   void checkNetworkStep();
-  template <class Law> void buildContactNetwork(detail::ContactNetwork& net) const;
+  std::vector<std::int32_t> networkBodies(detail::ContactNetwork& net) const;
+  template <class Law>
+  void visitTouchingContacts(const std::vector<std::int32_t>& body_of, const detail::ContactVisitor& visit) const;
   std::string stepAdvice() const;
   // On demand (contact_measures.cpp): World::particleStress, World::wallForces.
   template <class Law, class PairVisit, class WallVisit>

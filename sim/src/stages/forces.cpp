@@ -114,6 +114,7 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
 template <class Law>
 void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
   const int team = static_cast<int>(scratch.range_begin.size()) - 1;
+  const bool crossing = team > 1;  // one thread: no cross slots (assignRanges)
   // Clump members are integrated with their clump after the pass. A local copy:
   // the stores into the accumulators could alias the member flag otherwise.
   const std::int32_t* const clump_of = has_clumps ? p.clump.data() : nullptr;
@@ -134,13 +135,14 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
     // receives (pairs (i', p), i' < b, ascending i').
     for (std::uint32_t q = b; q < e; ++q) {
       Vec3 f = Vec3::Zero(), t = Vec3::Zero();
-      for (std::uint32_t c = nb.pairs.col_offset[q]; b > 0 && c < nb.pairs.col_offset[q + 1]; ++c) {
-        const std::uint32_t k = nb.pairs.col_pair[c];
-        if (scratch.cross_index[k] == ForceScratch::kNotCross) break;  // the rest come from this range
-        if (!history.pair_touch[k]) continue;
-        f += scratch.cross[scratch.cross_index[k]].fj;
-        t += scratch.cross[scratch.cross_index[k]].tj;
-      }
+      if (b > 0)  // the first range receives none (and one thread has no transpose)
+        for (std::uint32_t c = nb.pairs.col_offset[q]; c < nb.pairs.col_offset[q + 1]; ++c) {
+          const std::uint32_t k = nb.pairs.col_pair[c];
+          if (scratch.cross_index[k] == ForceScratch::kNotCross) break;  // the rest come from this range
+          if (!history.pair_touch[k]) continue;
+          f += scratch.cross[scratch.cross_index[k]].fj;
+          t += scratch.cross[scratch.cross_index[k]].tj;
+        }
       scratch.acc_force[q] = f;
       scratch.acc_torque[q] = t;
     }
@@ -148,7 +150,7 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
     for (std::uint32_t i = b; i < e; ++i) {
       Vec3 f = scratch.acc_force[i], t = scratch.acc_torque[i];
       for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
-        if (scratch.cross_index[k] != ForceScratch::kNotCross) {
+        if (crossing && scratch.cross_index[k] != ForceScratch::kNotCross) {
           if (!history.pair_touch[k]) continue;
           f += scratch.cross[scratch.cross_index[k]].fi;
           t += scratch.cross[scratch.cross_index[k]].ti;

@@ -90,6 +90,13 @@ void World::Impl::assignRanges() {
   const int team = teamSize();
   scratch.range_begin.resize(static_cast<std::size_t>(team) + 1);
   for (int t = 0; t <= team; ++t) scratch.range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
+  // One thread has no pair crossing two ranges: no slot index (4 bytes a pair).
+  if (team == 1) {
+    scratch.cross_index.clear();
+    scratch.cross_index.shrink_to_fit();
+    scratch.cross.clear();
+    return;
+  }
   scratch.cross_index.assign(nb.pairs.size(), ForceScratch::kNotCross);
   std::uint32_t slots = 0;
   for (int t = 0; t < team; ++t)
