@@ -17,7 +17,7 @@ double redness(const cv::Vec3b& p) { return std::max(0, int(p[2]) - std::max(int
 
 }  // namespace
 
-Blob componentBlob(const cv::Mat& labels, int label, const cv::Rect& box) {
+Blob componentBlob(const cv::Mat& labels, int label, const cv::Rect& box, cv::Point origin) {
   Blob blob;
   blob.core.reserve(static_cast<std::size_t>(box.area()));
   // The box grown by one pixel (clipped to the image) holds the core and its rim.
@@ -27,7 +27,7 @@ Blob componentBlob(const cv::Mat& labels, int label, const cv::Rect& box) {
     const int* row = labels.ptr<int>(v);
     for (int u = u0; u <= u1; ++u) {
       if (row[u] == label) {
-        blob.core.emplace_back(u, v);
+        blob.core.emplace_back(origin.x + u, origin.y + v);
         continue;
       }
       if (row[u] != 0) continue;  // another component's pixel is never our rim
@@ -44,7 +44,7 @@ Blob componentBlob(const cv::Mat& labels, int label, const cv::Rect& box) {
           }
         }
       }
-      if (touches) blob.rim.emplace_back(u, v);
+      if (touches) blob.rim.emplace_back(origin.x + u, origin.y + v);
     }
   }
   return blob;

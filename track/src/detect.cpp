@@ -75,15 +75,22 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     throw std::invalid_argument("detectMarkers: the image must be 8-bit BGR (CV_8UC3) and not empty");
 
   // 1. segment.
-  const cv::Mat mask = detail::redMask(bgr, settings);
+  cv::Range rows;
+  const cv::Mat mask = detail::redMask(bgr, settings, rows);
+  if (rows.empty()) return {};
 
-  // 2. components (label 0 is the background).
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  // 2. components (label 0 is the background), labelled on the rows with red pixels
+  // and one more on either side (the rim of stage 5); `labels` row 0 is frame row
+  // origin.y.
+  const cv::Range band(std::max(0, rows.start - 1), std::min(mask.rows, rows.end + 1));
+  const cv::Point origin(0, band.start);
+  const detail::Components components = detail::labelComponents(mask.rowRange(band));
+  const cv::Mat& labels = components.labels;
+  const int count = components.count();
   std::vector<int> candidates;
   std::vector<double> areas;
   for (int label = 1; label < count; ++label) {
-    const double area = stats.at<int>(label, cv::CC_STAT_AREA);
+    const double area = components.areas[static_cast<std::size_t>(label)];
     if (area < settings.min_area_px) continue;
     candidates.push_back(label);
     areas.push_back(area);
@@ -106,14 +113,14 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   // that is hidden or elsewhere, and must not cut a lone marker in two.
   const int reach = 1;
   for (const cv::Point2d& p : predictions)
-    if (const int label = labelNear(labels, p, reach); label > 0) predicted[static_cast<std::size_t>(label)].push_back(p);
+    if (const int label = labelNear(labels, p - cv::Point2d(origin), reach); label > 0)
+      predicted[static_cast<std::size_t>(label)].push_back(p);
 
   std::vector<Detection> out;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const int label = candidates[c];
-    const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                       stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    const detail::Blob blob = detail::componentBlob(labels, label, box);
+    const detail::Blob blob =
+        detail::componentBlob(labels, label, components.boxes[static_cast<std::size_t>(label)], origin);
     // 5. measure the whole component; 4. split it if it is touching markers
     // (large and not round), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};
