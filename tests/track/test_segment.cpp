@@ -131,7 +131,7 @@ TEST_CASE("components from runs are OpenCV's 8-connected components, numbered in
     bool same = true;
     for (int v = 0; v < mask.rows; ++v)
       for (int u = 0; u < mask.cols; ++u) {
-        const int a = mine.labels.at<int>(v, u), b = labels.at<int>(v, u);
+        const int a = mine.label(u, v), b = labels.at<int>(v, u);
         if (a != 0 && to_opencv[static_cast<std::size_t>(a)] == -1) first_seen.push_back(a);
         int& ab = to_opencv[static_cast<std::size_t>(a)];
         int& ba = from_opencv[static_cast<std::size_t>(b)];
@@ -147,5 +147,39 @@ TEST_CASE("components from runs are OpenCV's 8-connected components, numbered in
       CHECK(mine.boxes[static_cast<std::size_t>(a)] == cv::Rect(stats.at<int>(b, cv::CC_STAT_LEFT), stats.at<int>(b, cv::CC_STAT_TOP),
                                                                stats.at<int>(b, cv::CC_STAT_WIDTH), stats.at<int>(b, cv::CC_STAT_HEIGHT)));
     }
+  }
+}
+
+TEST_CASE("the enclosing circle of the rows' end pixels is the one of all pixels", "[track][detect]") {
+  // Discs, touching pairs (split pieces have rows with gaps) and random specks.
+  cv::Mat frame = greyFrame({320, 240}, 2.0, 13);
+  for (int k = 0; k < 8; ++k) drawDisc(frame, {20.0 + 37.3 * k, 30.0 + 21.7 * k}, 3.0 + 2.1 * k);
+  drawDisc(frame, {150.0, 200.0}, 9.0);
+  drawDisc(frame, {164.0, 203.0}, 9.0);
+  cv::Range rows;
+  const cv::Mat mask = detail::redMask(frame, DetectorSettings{}, rows);
+  const detail::Components components = detail::labelComponents(mask);
+  REQUIRE(components.count() == 10);
+  std::vector<std::vector<cv::Point>> sets;
+  for (int label = 1; label < components.count(); ++label) {
+    const detail::Blob blob = detail::componentBlob(components, label, components.boxes[static_cast<std::size_t>(label)]);
+    sets.push_back(blob.core);
+    for (const detail::Blob& piece : detail::splitBlob(blob, 2, 9.0)) sets.push_back(piece.core);
+  }
+  cv::RNG rng(14);
+  for (int k = 0; k < 20; ++k) {
+    std::vector<cv::Point> specks(1 + k * 3);
+    for (cv::Point& p : specks) p = {rng.uniform(0, 40), rng.uniform(0, 30)};
+    sets.push_back(specks);
+  }
+  for (const std::vector<cv::Point>& points : sets) {
+    cv::Point2f all_centre, ends_centre;
+    float all_radius = 0, ends_radius = 0;
+    cv::minEnclosingCircle(points, all_centre, all_radius);
+    const std::vector<cv::Point> ends = detail::rowEnds(points);
+    CHECK(ends.size() <= points.size());
+    cv::minEnclosingCircle(ends, ends_centre, ends_radius);
+    CHECK(ends_radius == Approx(all_radius).margin(1e-4));
+    CHECK(cv::norm(ends_centre - all_centre) < 1e-3);
   }
 }

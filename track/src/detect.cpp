@@ -46,7 +46,7 @@ namespace {
 // Component label under a predicted pixel: the pixel itself, else the nearest
 // labelled pixel within `reach` px;
 // 0 when none (outside the image or far from every component).
-int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
+int labelNear(const detail::Components& components, cv::Point2d prediction, int reach) {
   if (!std::isfinite(prediction.x) || !std::isfinite(prediction.y)) return 0;
   const long u = std::lround(prediction.x), v = std::lround(prediction.y);
   int best = 0;
@@ -54,9 +54,10 @@ int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
   for (long dv = -reach; dv <= reach; ++dv)
     for (long du = -reach; du <= reach; ++du) {
       const long uu = u + du, vv = v + dv, d = du * du + dv * dv;
-      if (uu < 0 || vv < 0 || uu >= labels.cols || vv >= labels.rows || d >= bestD || d > long(reach) * reach)
+      if (uu < 0 || vv < 0 || uu >= components.cols() || vv >= components.rows() || d >= bestD ||
+          d > long(reach) * reach)
         continue;
-      const int label = labels.at<int>(static_cast<int>(vv), static_cast<int>(uu));
+      const int label = components.label(static_cast<int>(uu), static_cast<int>(vv));
       if (label != 0) best = label, bestD = d;
     }
   return best;
@@ -80,12 +81,11 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   if (rows.empty()) return {};
 
   // 2. components (label 0 is the background), labelled on the rows with red pixels
-  // and one more on either side (the rim of stage 5); `labels` row 0 is frame row
+  // and one more on either side (the rim of stage 5); `components` row 0 is frame row
   // origin.y.
   const cv::Range band(std::max(0, rows.start - 1), std::min(mask.rows, rows.end + 1));
   const cv::Point origin(0, band.start);
   const detail::Components components = detail::labelComponents(mask.rowRange(band));
-  const cv::Mat& labels = components.labels;
   const int count = components.count();
   std::vector<int> candidates;
   std::vector<double> areas;
@@ -113,14 +113,14 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   // that is hidden or elsewhere, and must not cut a lone marker in two.
   const int reach = 1;
   for (const cv::Point2d& p : predictions)
-    if (const int label = labelNear(labels, p - cv::Point2d(origin), reach); label > 0)
+    if (const int label = labelNear(components, p - cv::Point2d(origin), reach); label > 0)
       predicted[static_cast<std::size_t>(label)].push_back(p);
 
   std::vector<Detection> out;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const int label = candidates[c];
     const detail::Blob blob =
-        detail::componentBlob(labels, label, components.boxes[static_cast<std::size_t>(label)], origin);
+        detail::componentBlob(components, label, components.boxes[static_cast<std::size_t>(label)], origin);
     // 5. measure the whole component; 4. split it if it is touching markers
     // (large and not round), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};

@@ -1,7 +1,5 @@
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
-#include <numeric>
 
 #include "detect_internal.h"
 
@@ -14,20 +12,7 @@ struct Run {
   int parent;           // union-find over run indices
 };
 
-// The first nonzero byte of row[from, width), or width; zero bytes are skipped
-// eight at a time (a marker mask is mostly zero).
-int nextSet(const std::uint8_t* row, int from, int width) {
-  int u = from;
-  for (; u + 8 <= width; u += 8) {
-    std::uint64_t word;
-    std::memcpy(&word, row + u, sizeof word);
-    if (word != 0) break;
-  }
-  while (u < width && row[u] == 0) ++u;
-  return u;
-}
-
-int nextClear(const std::uint8_t* row, int from, int width) {
+int nextZero(const std::uint8_t* row, int from, int width) {
   int u = from;
   while (u < width && row[u] != 0) ++u;
   return u;
@@ -54,8 +39,8 @@ Components labelComponents(const cv::Mat& mask) {
     const std::uint8_t* row = mask.ptr<std::uint8_t>(v);
     const std::size_t row_begin = runs.size();
     std::size_t a = above_begin;
-    for (int u = nextSet(row, 0, mask.cols); u < mask.cols; u = nextSet(row, u, mask.cols)) {
-      const int end = nextClear(row, u, mask.cols);
+    for (int u = nextNonzero(row, 0, mask.cols); u < mask.cols; u = nextNonzero(row, u, mask.cols)) {
+      const int end = nextZero(row, u, mask.cols);
       const int self = static_cast<int>(runs.size());
       runs.push_back({v, u, end, self});
       while (a < above_end && runs[a].end < u) ++a;  // ends left of this run's widened start
@@ -71,7 +56,8 @@ Components labelComponents(const cv::Mat& mask) {
   // 2. Labels 1, 2... in order of the components' first runs (raster order), areas,
   // boxes, and the label image.
   Components out;
-  out.labels = cv::Mat::zeros(mask.size(), CV_32S);
+  out.mask = mask;
+  out.labels.create(mask.size(), CV_32S);
   out.areas.push_back(0);
   out.boxes.emplace_back();
   std::vector<int> label_of(runs.size(), 0);

@@ -91,8 +91,7 @@ cv::Mat redPixels(const cv::Mat& bgr, const DetectorSettings& s, cv::Range& rows
     std::uint8_t* out = mask.ptr<std::uint8_t>(v);
     if (!candidates(in, out, bgr.cols, s.value_min, s.saturation_min, red_max_only)) continue;
     bool any = false;
-    for (int u = 0; u < bgr.cols; ++u) {
-      if (!out[u]) continue;
+    for (int u = nextNonzero(out, 0, bgr.cols); u < bgr.cols; u = nextNonzero(out, u + 1, bgr.cols)) {
       out[u] = exactlyRed(in[3 * u], in[3 * u + 1], in[3 * u + 2], s, q) ? 255 : 0;
       any = any || out[u];
     }
