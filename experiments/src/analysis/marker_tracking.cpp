@@ -24,7 +24,7 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   // tracks' predictions only above kSeededSplitAreas of that disc; at the detector's
   // 1.25 a lone clump that had shown as two blobs for a while kept a phantom second
   // track, and the marker's identity was split (demo: 19 of 20 markers, 30 tracks,
-  // 16 unresolved; at 1.3-1.6: 20 of 20, 26 tracks, 7 unresolved).
+  // 16 unresolved; at 1.3-1.5: 20 of 20, 26 tracks, 7 unresolved; at 1.6 the same markers).
   constexpr double kSeededSplitAreas = 1.4;
   s.detector.seeded_split_ratio = kSeededSplitAreas;
   // Gate: what a marker can move between two frames beyond the constant-velocity
