@@ -2,6 +2,7 @@
 // blob, stitching across a gap, and the evaluation's swap count.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -112,6 +113,54 @@ TEST_CASE("a marker hidden for some frames is re-found by stitching with its ide
   }
 }
 
+TEST_CASE("a track ended at an ambiguous match is stitched when its extrapolation decides it", "[track][identity]") {
+  // Marker A moves right with a ±0.75 px zig-zag in v (the visible centroid of a
+  // turning clump), so the linker's 2-point prediction misses it by 3 px each frame.
+  // Marker N comes down across A's path and is hidden from frame 23 to 33; at frame
+  // 25 its prediction passes 3.5 px from A, within 1/0.6 of A's own miss, so A's
+  // track ends there (ambiguous) and A goes on as a new track. N's prediction is
+  // not A's extrapolation (least squares over 8 frames: about 1 px off), so the
+  // stitch joins A to its continuation and N to its reappearance.
+  constexpr int frames = 42, crossing = 25, hidden_from = 23, hidden_to = 34, n_from = 10;
+  auto a = [](int k) { return cv::Point2d(40.0 + 3.1 * k, 120.2 + (k % 2 ? -0.75 : 0.75)); };
+  auto n = [&](int k) { return cv::Point2d(40.0 + 3.1 * crossing + 3.4, 120.2 + 6.0 * (k - crossing)); };
+  auto visible = [&](int marker, int k) { return marker == 0 || (k >= n_from && (k < hidden_from || k >= hidden_to)); };
+  TrackerSettings settings = settingsFor(kRadius);
+  settings.link.ambiguity_ratio = 0.6;
+  settings.stitch.ambiguity_ratio = 0.6;
+  const rocklab::geometry::Camera camera = rocklab::geometry::Camera::withFieldOfView(320, 240, 60.0);
+  std::vector<TruthMarker> truth(2);
+  Tracker tracker(settings);
+  for (int k = 0; k < frames; ++k) {
+    cv::Mat frame = greyFrame({320, 240}, 2.0, 300 + k);
+    for (int marker : {0, 1}) {
+      if (!visible(marker, k)) continue;
+      const cv::Point2d p = marker == 0 ? a(k) : n(k);
+      drawDisc(frame, p, kRadius);
+      const auto ray = camera.pixelRay({p.x, p.y});
+      truth[static_cast<std::size_t>(marker)].points.push_back({k, p, ray / ray.z()});
+    }
+    tracker.add(k, k / kFrameRate, frame);
+  }
+  truth[1].id = 1;
+  // The case this test is about happened: A's first track ended at an ambiguous match.
+  REQUIRE(tracker.linker().ambiguousEnds().size() == 1);
+  const StitchResult result = tracker.finish();
+  CHECK(result.joins.size() == 2);
+  CHECK(result.unresolved.empty());
+  EvaluationSettings s;
+  s.match_distance_px = kRadius;
+  s.image_size = {320, 240};
+  const TrackingEvaluation e = evaluateTracks(result.tracks, truth, camera, {0, 0, 1}, {0, 0, 1}, {}, s);
+  CHECK(e.identity_swaps == 0);
+  for (const MarkerScore& m : e.markers) {
+    INFO("marker " << m.truth_id);
+    CHECK(m.fraction_found == 1.0);
+    CHECK(m.track_ids.size() == 1);  // one track from first to last frame: its identity kept
+  }
+  CHECK(result.tracks.size() == 2);
+}
+
 TEST_CASE("two tracks starting near an ended one are unresolved, not merged", "[track][identity]") {
   // Track 0 ends heading right; tracks 1 and 2 start equally near its extrapolation.
   std::vector<Track> tracks(3);
@@ -127,14 +176,24 @@ TEST_CASE("two tracks starting near an ended one are unresolved, not merged", "[
   CHECK(result.joins.empty());
   CHECK(result.tracks.size() == 3);
   CHECK(result.unresolved == std::vector<int>{0, 1, 2});
-  // One of them clearly nearer: joined.
+  // Track 0 ended at an ambiguous match: the same tests, still unresolved.
+  const StitchResult ended_ambiguous = stitchTracks(tracks, s, {0});
+  CHECK(ended_ambiguous.joins.empty());
+  CHECK(ended_ambiguous.unresolved == std::vector<int>{0, 1, 2});
+  // One of them clearly nearer: joined, whether track 0 ended ambiguous or not.
   for (TrackPoint& p : tracks[2].points) p.pixel.y = 58.0;
-  const StitchResult clear = stitchTracks(tracks, s);
-  REQUIRE(clear.joins.size() == 1);
-  CHECK(clear.joins[0].from_id == 0);
-  CHECK(clear.joins[0].to_id == 1);
-  CHECK(clear.tracks.size() == 2);
-  CHECK(clear.tracks[0].points.size() == 20);
+  for (const std::vector<int>& ambiguous : {std::vector<int>{}, std::vector<int>{0}}) {
+    const StitchResult clear = stitchTracks(tracks, s, ambiguous);
+    REQUIRE(clear.joins.size() == 1);
+    CHECK(clear.joins[0].from_id == 0);
+    CHECK(clear.joins[0].to_id == 1);
+    CHECK(clear.tracks.size() == 2);
+    CHECK(clear.tracks[0].points.size() == 20);
+    CHECK(std::find(clear.unresolved.begin(), clear.unresolved.end(), 0) == clear.unresolved.end());
+  }
+  // An ambiguous end with no candidate after it stays reported.
+  tracks.resize(1);
+  CHECK(stitchTracks(tracks, s, {0}).unresolved == std::vector<int>{0});
   CHECK_THROWS_WITH(stitchTracks(tracks, StitchSettings{-1}), Catch::Contains("stitch.max_gap_frames"));
 }
 

@@ -46,7 +46,7 @@ namespace {
 // Component label under a predicted pixel: the pixel itself, else the nearest
 // labelled pixel within `reach` px;
 // 0 when none (outside the image or far from every component).
-int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
+int labelNear(const detail::Components& components, cv::Point2d prediction, int reach) {
   if (!std::isfinite(prediction.x) || !std::isfinite(prediction.y)) return 0;
   const long u = std::lround(prediction.x), v = std::lround(prediction.y);
   int best = 0;
@@ -54,9 +54,10 @@ int labelNear(const cv::Mat& labels, cv::Point2d prediction, int reach) {
   for (long dv = -reach; dv <= reach; ++dv)
     for (long du = -reach; du <= reach; ++du) {
       const long uu = u + du, vv = v + dv, d = du * du + dv * dv;
-      if (uu < 0 || vv < 0 || uu >= labels.cols || vv >= labels.rows || d >= bestD || d > long(reach) * reach)
+      if (uu < 0 || vv < 0 || uu >= components.cols() || vv >= components.rows() || d >= bestD ||
+          d > long(reach) * reach)
         continue;
-      const int label = labels.at<int>(static_cast<int>(vv), static_cast<int>(uu));
+      const int label = components.label(static_cast<int>(uu), static_cast<int>(vv));
       if (label != 0) best = label, bestD = d;
     }
   return best;
@@ -75,15 +76,21 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     throw std::invalid_argument("detectMarkers: the image must be 8-bit BGR (CV_8UC3) and not empty");
 
   // 1. segment.
-  const cv::Mat mask = detail::redMask(bgr, settings);
+  cv::Range rows;
+  const cv::Mat mask = detail::redMask(bgr, settings, rows);
+  if (rows.empty()) return {};
 
-  // 2. components (label 0 is the background).
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  // 2. components (label 0 is the background), labelled on the rows with red pixels
+  // and one more on either side (the rim of stage 5); `components` row 0 is frame row
+  // origin.y.
+  const cv::Range band(std::max(0, rows.start - 1), std::min(mask.rows, rows.end + 1));
+  const cv::Point origin(0, band.start);
+  const detail::Components components = detail::labelComponents(mask.rowRange(band));
+  const int count = components.count();
   std::vector<int> candidates;
   std::vector<double> areas;
   for (int label = 1; label < count; ++label) {
-    const double area = stats.at<int>(label, cv::CC_STAT_AREA);
+    const double area = components.areas[static_cast<std::size_t>(label)];
     if (area < settings.min_area_px) continue;
     candidates.push_back(label);
     areas.push_back(area);
@@ -106,14 +113,14 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   // that is hidden or elsewhere, and must not cut a lone marker in two.
   const int reach = 1;
   for (const cv::Point2d& p : predictions)
-    if (const int label = labelNear(labels, p, reach); label > 0) predicted[static_cast<std::size_t>(label)].push_back(p);
+    if (const int label = labelNear(components, p - cv::Point2d(origin), reach); label > 0)
+      predicted[static_cast<std::size_t>(label)].push_back(p);
 
   std::vector<Detection> out;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const int label = candidates[c];
-    const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                       stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    const detail::Blob blob = detail::componentBlob(labels, label, box);
+    const detail::Blob blob =
+        detail::componentBlob(components, label, components.boxes[static_cast<std::size_t>(label)], origin);
     // 5. measure the whole component; 4. split it if it is touching markers
     // (large and not round), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};

@@ -53,13 +53,15 @@ StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings
                           const std::vector<int>& ended_ambiguous) {
   settings.validate();
   const std::size_t n = tracks.size();
-  auto closed = [&](const Track& t) {
+  auto endedAmbiguous = [&](const Track& t) {
     return std::find(ended_ambiguous.begin(), ended_ambiguous.end(), t.id) != ended_ambiguous.end();
   };
-  // miss[a][b]: candidate A → B within both gates, else infinity.
+  // miss[a][b]: candidate A → B within both gates, else infinity. A track that
+  // ended at an ambiguous match is a candidate like any other: the linker's 2-point
+  // prediction was in doubt, the least-squares extrapolation here decides it, and
+  // only through the same mutual-nearest and ratio tests.
   std::vector<double> miss(n * n, kNone);
   for (std::size_t a = 0; a < n; ++a) {
-    if (closed(tracks[a])) continue;
     const TrackPoint& end = tracks[a].points.back();
     for (std::size_t b = 0; b < n; ++b) {
       const TrackPoint& start = tracks[b].points.front();
@@ -102,9 +104,11 @@ StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings
     out.joins.push_back({tracks[a].id, tracks[b].id, tracks[b].points.front().frame - tracks[a].points.back().frame - 1,
                          successor.first});
   }
-  // Unresolved: a track that had a candidate on a side and was not joined there.
+  // Unresolved: a track that had a candidate on a side and was not joined there, or
+  // that ended at an ambiguous match and was not continued.
   for (std::size_t k = 0; k < n; ++k)
-    if ((candidate_after[k] && next[k] == n) || (candidate_before[k] && !has_previous[k]) || closed(tracks[k]))
+    if ((candidate_after[k] && next[k] == n) || (candidate_before[k] && !has_previous[k]) ||
+        (endedAmbiguous(tracks[k]) && next[k] == n))
       out.unresolved.push_back(tracks[k].id);
   for (std::size_t k = 0; k < n; ++k) {
     if (has_previous[k]) continue;  // part of a chain started earlier

@@ -3,9 +3,14 @@
 //
 // The pipeline, in order (src/detect.cpp):
 //   1. segment    — HSV thresholds, two hue bands around red (OpenCV's 8-bit hue
-//                   runs 0..179, red wraps at 0/180), then a morphological open
-//                   (a square of open_kernel_px) that removes specks and threads;
-//   2. components — 8-connected components with their pixel counts;
+//                   runs 0..179, red wraps at 0/180): the pixels cv::cvtColor +
+//                   cv::inRange would give, bit for bit, tested in one pass over the
+//                   BGR pixels (a vectorised superset test, then OpenCV's fixed-point
+//                   HSV on the few candidates); then a morphological open (a square
+//                   of open_kernel_px) that removes specks and threads, on the rows
+//                   with red pixels only;
+//   2. components — 8-connected components with their pixel counts, from the runs
+//                   of mask pixels (a mostly empty mask costs little);
 //   3. reference  — the area of one marker: expected_area_px, or (0) the median
 //                   area of this frame's components;
 //   4. split      — (a) prediction-seeded: a component into which two or more of the
@@ -73,7 +78,8 @@ struct DetectorSettings {
 
 /// Red markers in a BGR image (CV_8UC3). Settings are validated; an image of
 /// another type throws std::invalid_argument. No marker → an empty list.
-/// Detections are in row-major order of their components (top to bottom).
+/// Detections are in row-major order of their components (of their first pixel:
+/// top to bottom, then left to right).
 std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings = {});
 
 /// The same, with the tracks' predicted pixels for this frame (Linker::predictions):

@@ -45,8 +45,10 @@ struct StitchResult {
 };
 
 /// Tracks as Linker::tracks() gives them (points by increasing frame, none empty).
-/// `ended_ambiguous` (Linker::ambiguousEnds): tracks never continued by a stitch
-/// (their marker is in doubt already); they are listed unresolved.
+/// `ended_ambiguous` (Linker::ambiguousEnds): tracks that ended at an ambiguous
+/// match; they are joined only as above (the least-squares extrapolation and the
+/// ratio test decide what the linker's 2-point prediction could not), and one not
+/// continued is listed unresolved.
 StitchResult stitchTracks(const std::vector<Track>& tracks, const StitchSettings& settings,
                           const std::vector<int>& ended_ambiguous = {});
 

@@ -26,6 +26,8 @@ class Tracker {
   /// The linker's tracks, stitched.
   StitchResult finish() const;
   const TrackerSettings& settings() const { return settings_; }
+  /// The tracks before stitching, and which ended at an ambiguous match.
+  const Linker& linker() const { return linker_; }
 
  private:
   TrackerSettings settings_;
