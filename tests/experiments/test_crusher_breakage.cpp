@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -163,6 +164,8 @@ TEST_CASE("a ball between two closing walls breaks when q exceeds its strength a
   CHECK(e.parent == 0);
   CHECK(e.fragments == std::vector<std::uint64_t>{1, 2, 3});  // new ids
   CHECK(e.freeze_cycles > 0);
+  CHECK(e.freeze_end == crusher::FreezeEnd::Converged);  // free to part: the overlap criterion
+  CHECK(e.freeze_overlap <= settings.freeze.overlap_fraction);
   // Two opposite point forces F: q = (2 sqrt 2 / pi) F / d^2 = 0.9 F / d^2 (Eq 6-12,
   // dem-models §11), the contact points a half overlap (4 um of 10 mm) inside.
   CHECK(q == Approx(2 * std::sqrt(2.0) / std::numbers::pi * wall_force / 4e-4).epsilon(1e-3));
@@ -212,6 +215,93 @@ TEST_CASE("a freeze that does not end within freeze_max_cycles stops with both c
                           Contains("freeze_kinetic_fraction"));
 }
 
+namespace {
+
+/// Two 10 mm fragments overlapping by 2 mm (0.4 of their radius) in a row along x
+/// with an unbroken 10 mm rock ball touching the second: the rock ball's stiffness
+/// at the freeze's huge density sets the freeze's step, so the fragments move on a
+/// time scale thousands of cycles long, as in the crusher. `walls`: a held plane
+/// 0.5 mm into the first fragment and one touching the rock ball, 27.5 mm apart
+/// for 28 mm of balls; the fragments cannot separate: in the chain wall-A-B-ball-wall
+/// (soft springs 1e3, 500 and 1e3 N/m; the ball's stiff) the pair keeps 1.25 mm of
+/// the 2.5 mm, 0.25 of the radius.
+struct FreezeCase {
+  sim::Model model;
+  sim::WorldState state;
+};
+
+FreezeCase fragmentRow(bool walls) {
+  sim::Model m;
+  m.materials.push_back({"rock", 2650, 1e9, 1e9, 0.0});
+  m.materials.push_back({"steel", 7800, 1e13, 1e13, 0.0});
+  m.gravity = Vec3::Zero();
+  m.watchdog.max_overlap_fraction = std::numeric_limits<double>::infinity();  // the fragments overlap by design
+  const double r = 0.005;
+  if (walls) {
+    sim::Wall left;
+    left.name = "left";
+    left.point = Vec3(-0.0085, 0, 0);
+    left.normal = Vec3::UnitX();
+    left.material = 1;
+    sim::Wall right = left;
+    right.name = "right";
+    right.point = Vec3(0.019, 0, 0);
+    right.normal = -Vec3::UnitX();
+    m.walls = {left, right};
+  }
+  std::vector<sim::SphereSpec> balls(3);
+  balls[0].position = Vec3(-0.004, 0, 0);
+  balls[1].position = Vec3(0.004, 0, 0);
+  balls[2].position = Vec3(0.014, 0, 0);
+  for (auto& b : balls) b.radius = r;
+  sim::World world(m, balls, 1);
+  return {m, world.exportState()};
+}
+
+}  // namespace
+
+TEST_CASE("a freeze whose fragments are pinched between held walls ends as stalled with the overlap they keep; free "
+          "fragments still converge",
+          "[crusher]") {
+  const crusher::FreezeSettings settings;  // the defaults
+  const std::vector<std::uint32_t> fragments{0, 1};
+  FreezeCase pinched = fragmentRow(true);
+  const crusher::FreezeResult stalled = crusher::freezeFragments(pinched.model, pinched.state, fragments, settings, 1);
+  INFO("pinched: " << stalled.cycles << " cycles of " << stalled.dt << " s, window " << stalled.stall_window_cycles
+                   << " cycles, overlap " << stalled.max_overlap << ", kinetic " << stalled.kinetic_energy << " of "
+                   << stalled.artificial_energy << " J");
+  CHECK(stalled.end == crusher::FreezeEnd::Stalled);
+  CHECK(std::string(crusher::freezeEndName(stalled.end)) == "stalled");
+  // What the walls allow: the damped pair swings just past its rest (0.25, which a
+  // run without the stall rule reaches to 1e-5 after 240,000 cycles) and creeps
+  // back; the overlap has stopped falling there, so the rule ends the freeze at or
+  // near its lowest value.
+  CHECK(stalled.max_overlap > 0.2);
+  CHECK(stalled.max_overlap <= 0.25 * 1.001);
+  CHECK(stalled.kinetic_energy <= settings.kinetic_fraction * stalled.artificial_energy);
+  CHECK(stalled.stall_window_cycles > 1000);  // the window is the fragments' time, not a handful of cycles
+  CHECK(stalled.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 4);
+  const sim::ParticleState& p = pinched.state.particles;
+  CHECK(2 * p.radius[0] - (p.position[1] - p.position[0]).norm() == Approx(stalled.max_overlap * 0.005));  // kept
+
+  // The same row without the walls: the pair pushes itself and the ball apart and
+  // meets the overlap criterion (the stall rule must not end it while the fragments
+  // are still getting under way).
+  FreezeCase free = fragmentRow(false);
+  const crusher::FreezeResult converged = crusher::freezeFragments(free.model, free.state, fragments, settings, 1);
+  INFO("free: " << converged.cycles << " cycles, overlap " << converged.max_overlap);
+  CHECK(converged.end == crusher::FreezeEnd::Converged);
+  CHECK(converged.max_overlap <= settings.overlap_fraction);
+
+  // Without the stall rule the pinched row runs into freeze_max_cycles, as before.
+  crusher::FreezeSettings no_stall = settings;
+  no_stall.stall_window = 0;
+  no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
+  FreezeCase again = fragmentRow(true);
+  CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
+                    Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
+}
+
 TEST_CASE("breakage settings: off by default, keys checked by name, and a step too long for the smallest fragment "
           "stops the run as bad input",
           "[scene][crusher]") {
@@ -235,6 +325,9 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
   CHECK_THAT(error("experiment.breakage.mode=\"quad\""), Contains("experiment.breakage.mode"));
   CHECK_THAT(error("experiment.breakage.offsets=[0.5,0]"), Contains("experiment.breakage.offsets") && Contains("needs 3"));
   CHECK_THAT(error("experiment.breakage.freeze_local_damping=1.5"), Contains("freeze_local_damping"));
+  CHECK_THAT(error("experiment.breakage.freeze_stall_tolerance=1"),
+             Contains("experiment.breakage.freeze_stall_tolerance") && Contains("[0, 1)"));
+  CHECK_THAT(error("experiment.breakage.freeze_stall_window=-1"), Contains("experiment.breakage.freeze_stall_window"));
   CHECK_THAT(error("experiment.breakage.q_reff=1"), Contains("q_reff"));
 
   // The tiny run's step (soft contacts) is too long for a 1.9 mm fragment at 70 GPa.
@@ -294,8 +387,11 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
     const auto& balance = b["mass_balance"];
     CHECK(balance["feed_kg"].get<double>() ==
           Approx(balance["product_kg"].get<double>() + balance["in_chamber_kg"].get<double>()).epsilon(1e-14));
+    CHECK(b["freezes_converged"].get<int>() + b["freezes_stalled"].get<int>() == b["freezes"].get<int>());
+    CHECK(b["max_freeze_overlap_fraction"].get<double>() >= 0);
     const std::string events = test::slurp(out / "breakage.csv");
     CHECK(std::count(events.begin(), events.end(), '\n') == 1 + b["events"].get<int>());
+    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction\n"));
     if (threads == 1)
       first_events = events;
     else
