@@ -260,7 +260,7 @@ FreezeCase fragmentRow(bool walls) {
 
 }  // namespace
 
-TEST_CASE("a freeze whose fragments are pinched between held walls ends as stalled with the overlap they keep; free "
+TEST_CASE("a freeze whose fragments are pinched between held walls ends as stalled with the overlap they keep, and free "
           "fragments still converge",
           "[crusher]") {
   const crusher::FreezeSettings settings;  // the defaults
