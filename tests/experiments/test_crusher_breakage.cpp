@@ -166,6 +166,7 @@ TEST_CASE("a ball between two closing walls breaks when q exceeds its strength a
   CHECK(e.freeze_cycles > 0);
   CHECK(e.freeze_end == crusher::FreezeEnd::Converged);  // free to part: the overlap criterion
   CHECK(e.freeze_overlap <= settings.freeze.overlap_fraction);
+  CHECK_THAT(breakage.progress(), Contains("1 broken, freezes 1 converged 0 stalled"));
   // Two opposite point forces F: q = (2 sqrt 2 / pi) F / d^2 = 0.9 F / d^2 (Eq 6-12,
   // dem-models §11), the contact points a half overlap (4 um of 10 mm) inside.
   CHECK(q == Approx(2 * std::sqrt(2.0) / std::numbers::pi * wall_force / 4e-4).epsilon(1e-3));

@@ -176,6 +176,15 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   return true;
 }
 
+std::string CrusherBreakage::progress() const {
+  std::ostringstream s;
+  s << events_.size() << " broken";
+  if (freezes_ > 0)
+    s << ", freezes " << freezes_ - freezes_stalled_ << " converged " << freezes_stalled_ << " stalled (overlap left <= "
+      << max_freeze_overlap_ << ", " << freeze_cycles_ << " cycles)";
+  return s.str();
+}
+
 nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, const std::filesystem::path& out_dir) const {
   // Broken balls by the product's sieve classes (parent diameter).
   std::vector<double> edges{0};

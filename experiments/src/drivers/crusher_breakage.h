@@ -64,6 +64,9 @@ class CrusherBreakage {
   bool check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx);
 
   const std::vector<BreakageEvent>& events() const { return events_; }
+  /// For the progress line: the events and how the freezes so far ended (the
+  /// report is written only at the end of a run).
+  std::string progress() const;
   std::size_t fragmentsCreated() const { return fragments_created_; }
   /// results.json's crusher.breakage (without the mass balance, which the driver
   /// adds) and breakage.csv.
