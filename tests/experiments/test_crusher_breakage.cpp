@@ -8,6 +8,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 
 #include "cli_support.h"
 #include "crusher/breakage_model.h"
@@ -218,43 +219,43 @@ TEST_CASE("a freeze that does not end within freeze_max_cycles stops with both c
 
 namespace {
 
-/// Two 10 mm fragments overlapping by 2 mm (0.4 of their radius) in a row along x
-/// with an unbroken 10 mm rock ball touching the second: the rock ball's stiffness
-/// at the freeze's huge density sets the freeze's step, so the fragments move on a
-/// time scale thousands of cycles long, as in the crusher. `walls`: a held plane
-/// 0.5 mm into the first fragment and one touching the rock ball, 27.5 mm apart
-/// for 28 mm of balls; the fragments cannot separate: in the chain wall-A-B-ball-wall
-/// (soft springs 1e3, 500 and 1e3 N/m; the ball's stiff) the pair keeps 1.25 mm of
-/// the 2.5 mm, 0.25 of the radius.
+/// Two 10 mm fragments overlapping by `start` (m) in a row along x with an
+/// unbroken 10 mm rock ball touching the second: the rock ball's stiffness at the
+/// freeze's huge density sets the freeze's step, so the fragments move on a time
+/// scale thousands of cycles long, as in the crusher. With `keep` (m): two held
+/// planes, one touching the ball, the other as far as makes the pair keep that
+/// overlap at rest: the chain wall-A-B-ball-wall (soft springs 1e3, 500 and 1e3
+/// N/m; the ball's stiff) is 6 radii long unloaded and the pair takes half of
+/// what the walls take off it.
 struct FreezeCase {
   sim::Model model;
   sim::WorldState state;
 };
 
-FreezeCase fragmentRow(bool walls) {
+FreezeCase fragmentRow(double start, std::optional<double> keep) {
   sim::Model m;
   m.materials.push_back({"rock", 2650, 1e9, 1e9, 0.0});
   m.materials.push_back({"steel", 7800, 1e13, 1e13, 0.0});
   m.gravity = Vec3::Zero();
   m.watchdog.max_overlap_fraction = std::numeric_limits<double>::infinity();  // the fragments overlap by design
-  const double r = 0.005;
-  if (walls) {
-    sim::Wall left;
-    left.name = "left";
-    left.point = Vec3(-0.0085, 0, 0);
-    left.normal = Vec3::UnitX();
-    left.material = 1;
-    sim::Wall right = left;
+  const double r = 0.005, b = r - start / 2, c = b + 2 * r;
+  if (keep) {
+    sim::Wall right;
     right.name = "right";
-    right.point = Vec3(0.019, 0, 0);
+    right.point = Vec3(c + r, 0, 0);
     right.normal = -Vec3::UnitX();
+    right.material = 1;
+    sim::Wall left = right;
+    left.name = "left";
+    left.point = Vec3(c + r - (6 * r - 2 * *keep), 0, 0);
+    left.normal = Vec3::UnitX();
     m.walls = {left, right};
   }
   std::vector<sim::SphereSpec> balls(3);
-  balls[0].position = Vec3(-0.004, 0, 0);
-  balls[1].position = Vec3(0.004, 0, 0);
-  balls[2].position = Vec3(0.014, 0, 0);
-  for (auto& b : balls) b.radius = r;
+  balls[0].position = Vec3(-b, 0, 0);
+  balls[1].position = Vec3(b, 0, 0);
+  balls[2].position = Vec3(c, 0, 0);
+  for (auto& ball : balls) ball.radius = r;
   sim::World world(m, balls, 1);
   return {m, world.exportState()};
 }
@@ -266,19 +267,21 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
           "[crusher]") {
   const crusher::FreezeSettings settings;  // the defaults
   const std::vector<std::uint32_t> fragments{0, 1};
-  FreezeCase pinched = fragmentRow(true);
+  // Snug: 0.1 mm (0.02 of the radius) at the split, 25 um (0.005) kept, within
+  // freeze_stall_max_overlap. (Parting from a deeper overlap the pair swings past
+  // its rest and is apart for a moment, which ends the freeze as converged.)
+  FreezeCase pinched = fragmentRow(1e-4, 25e-6);
   const crusher::FreezeResult stalled = crusher::freezeFragments(pinched.model, pinched.state, fragments, settings, 1);
   INFO("pinched: " << stalled.cycles << " cycles of " << stalled.dt << " s, window " << stalled.stall_window_cycles
                    << " cycles, overlap " << stalled.max_overlap << ", kinetic " << stalled.kinetic_energy << " of "
                    << stalled.artificial_energy << " J");
   CHECK(stalled.end == crusher::FreezeEnd::Stalled);
   CHECK(std::string(crusher::freezeEndName(stalled.end)) == "stalled");
-  // What the walls allow: the damped pair swings just past its rest (0.25, which a
-  // run without the stall rule reaches to 1e-5 after 240,000 cycles) and creeps
-  // back; the overlap has stopped falling there, so the rule ends the freeze at or
-  // near its lowest value.
-  CHECK(stalled.max_overlap > 0.2);
-  CHECK(stalled.max_overlap <= 0.25 * 1.001);
+  // What the walls allow (0.005), nearly: the last approach to rest under local
+  // damping is a creep (the damped force is 0.1 of a spring force that vanishes at
+  // rest) slower than 1 % per window, so the rule ends it a little above.
+  CHECK(stalled.max_overlap >= 0.005 * 0.999);
+  CHECK(stalled.max_overlap < 0.005 * 1.25);
   CHECK(stalled.kinetic_energy <= settings.kinetic_fraction * stalled.artificial_energy);
   CHECK(stalled.stall_window_cycles > 1000);  // the window is the fragments' time, not a handful of cycles
   CHECK(stalled.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 4);
@@ -288,17 +291,32 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
   // The same row without the walls: the pair pushes itself and the ball apart and
   // meets the overlap criterion (the stall rule must not end it while the fragments
   // are still getting under way).
-  FreezeCase free = fragmentRow(false);
+  FreezeCase free = fragmentRow(2e-3, std::nullopt);
   const crusher::FreezeResult converged = crusher::freezeFragments(free.model, free.state, fragments, settings, 1);
   INFO("free: " << converged.cycles << " cycles, overlap " << converged.max_overlap);
   CHECK(converged.end == crusher::FreezeEnd::Converged);
   CHECK(converged.max_overlap <= settings.overlap_fraction);
 
-  // Without the stall rule the pinched row runs into freeze_max_cycles, as before.
+  // Tight: 2 mm (0.4) at the split, 1.25 mm (0.25) kept, above
+  // freeze_stall_max_overlap: no stall, the freeze runs into freeze_max_cycles;
+  // with the bound raised it stalls there.
+  crusher::FreezeSettings capped = settings;
+  capped.max_cycles = static_cast<std::int64_t>(4 * stalled.cycles);
+  FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
+  CHECK_THROWS_WITH(crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1),
+                    Contains("freeze_max_cycles") && Contains("freeze_stall_max_overlap = 0.01"));
+  capped.stall_max_overlap = 0.3;
+  tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult deep = crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
+  CHECK(deep.end == crusher::FreezeEnd::Stalled);
+  CHECK(deep.max_overlap > 0.2);
+  CHECK(deep.max_overlap <= 0.25 * 1.001);
+
+  // Without the stall rule the snug row runs into freeze_max_cycles, as before.
   crusher::FreezeSettings no_stall = settings;
   no_stall.stall_window = 0;
   no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
-  FreezeCase again = fragmentRow(true);
+  FreezeCase again = fragmentRow(1e-4, 25e-6);
   CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
                     Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
 }

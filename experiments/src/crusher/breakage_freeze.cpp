@@ -148,7 +148,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
       const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample
       // The overlap criterion first: a freeze that can converge ends as converged.
       if (at_rest && result.max_overlap <= s.overlap_fraction) break;
-      if (at_rest && stalled) {
+      if (at_rest && stalled && result.max_overlap <= s.stall_max_overlap) {
         result.end = FreezeEnd::Stalled;
         break;
       }
@@ -162,7 +162,8 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
             << result.artificial_energy << " J (freeze_kinetic_fraction = " << s.kinetic_fraction
             << ") and it has not stalled (freeze_stall_tolerance = " << s.stall_tolerance
             << " over freeze_stall_window = " << s.stall_window << " fragment time scales, "
-            << result.stall_window_cycles << " cycles"
+            << result.stall_window_cycles << " cycles, at an overlap of at most freeze_stall_max_overlap = "
+            << s.stall_max_overlap
             << "); raise freeze_max_cycles or relax the criteria";
         throw std::runtime_error(msg.str());
       }

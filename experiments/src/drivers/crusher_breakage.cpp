@@ -43,6 +43,7 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   f.kinetic_fraction = b->number("freeze_kinetic_fraction", f.kinetic_fraction, Range::nonNegative());
   f.stall_tolerance = b->number("freeze_stall_tolerance", f.stall_tolerance, {0.0, 1.0, false, true});
   f.stall_window = b->number("freeze_stall_window", f.stall_window, Range::closed(0.0, 1e6));
+  f.stall_max_overlap = b->number("freeze_stall_max_overlap", f.stall_max_overlap, Range::nonNegative());
   f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
   f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
   b->finish();
