@@ -580,7 +580,7 @@ freeze_kinetic_fraction = 0.2
 freeze_stall_tolerance = 0.01
 freeze_stall_window = 2
 freeze_stall_max_overlap = 0.01
-freeze_max_cycles = 200000
+freeze_max_cycles = 1000000
 freeze_check_cycles = 20
 )",
 };
