@@ -5,8 +5,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 
 #include "cli_support.h"
 #include "crusher/breakage_model.h"
@@ -163,6 +165,9 @@ TEST_CASE("a ball between two closing walls breaks when q exceeds its strength a
   CHECK(e.parent == 0);
   CHECK(e.fragments == std::vector<std::uint64_t>{1, 2, 3});  // new ids
   CHECK(e.freeze_cycles > 0);
+  CHECK(e.freeze_end == crusher::FreezeEnd::Converged);  // free to part: the overlap criterion
+  CHECK(e.freeze_overlap <= settings.freeze.overlap_fraction);
+  CHECK_THAT(breakage.progress(), Contains("1 broken, freezes 1 converged 0 stalled"));
   // Two opposite point forces F: q = (2 sqrt 2 / pi) F / d^2 = 0.9 F / d^2 (Eq 6-12,
   // dem-models §11), the contact points a half overlap (4 um of 10 mm) inside.
   CHECK(q == Approx(2 * std::sqrt(2.0) / std::numbers::pi * wall_force / 4e-4).epsilon(1e-3));
@@ -212,6 +217,111 @@ TEST_CASE("a freeze that does not end within freeze_max_cycles stops with both c
                           Contains("freeze_kinetic_fraction"));
 }
 
+namespace {
+
+/// Two 10 mm fragments overlapping by `start` (m) in a row along x with an
+/// unbroken 10 mm rock ball touching the second: the rock ball's stiffness at the
+/// freeze's huge density sets the freeze's step, so the fragments move on a time
+/// scale thousands of cycles long, as in the crusher. With `keep` (m): two held
+/// planes, one touching the ball, the other as far as makes the pair keep that
+/// overlap at rest: the chain wall-A-B-ball-wall (soft springs 1e3, 500 and 1e3
+/// N/m; the ball's stiff) is 6 radii long unloaded and the pair takes half of
+/// what the walls take off it.
+struct FreezeCase {
+  sim::Model model;
+  sim::WorldState state;
+};
+
+FreezeCase fragmentRow(double start, std::optional<double> keep) {
+  sim::Model m;
+  m.materials.push_back({"rock", 2650, 1e9, 1e9, 0.0});
+  m.materials.push_back({"steel", 7800, 1e13, 1e13, 0.0});
+  m.gravity = Vec3::Zero();
+  m.watchdog.max_overlap_fraction = std::numeric_limits<double>::infinity();  // the fragments overlap by design
+  const double r = 0.005, b = r - start / 2, c = b + 2 * r;
+  if (keep) {
+    sim::Wall right;
+    right.name = "right";
+    right.point = Vec3(c + r, 0, 0);
+    right.normal = -Vec3::UnitX();
+    right.material = 1;
+    sim::Wall left = right;
+    left.name = "left";
+    left.point = Vec3(c + r - (6 * r - 2 * *keep), 0, 0);
+    left.normal = Vec3::UnitX();
+    m.walls = {left, right};
+  }
+  std::vector<sim::SphereSpec> balls(3);
+  balls[0].position = Vec3(-b, 0, 0);
+  balls[1].position = Vec3(b, 0, 0);
+  balls[2].position = Vec3(c, 0, 0);
+  for (auto& ball : balls) ball.radius = r;
+  sim::World world(m, balls, 1);
+  return {m, world.exportState()};
+}
+
+}  // namespace
+
+TEST_CASE("a freeze whose fragments are pinched between held walls ends as stalled with the overlap they keep, and free "
+          "fragments still converge",
+          "[crusher]") {
+  const crusher::FreezeSettings settings;  // the defaults
+  const std::vector<std::uint32_t> fragments{0, 1};
+  // Snug: 0.1 mm (0.02 of the radius) at the split, 25 um (0.005) kept, within
+  // freeze_stall_max_overlap. (Parting from a deeper overlap the pair swings past
+  // its rest and is apart for a moment, which ends the freeze as converged.)
+  FreezeCase pinched = fragmentRow(1e-4, 25e-6);
+  const crusher::FreezeResult stalled = crusher::freezeFragments(pinched.model, pinched.state, fragments, settings, 1);
+  INFO("pinched: " << stalled.cycles << " cycles of " << stalled.dt << " s, window " << stalled.stall_window_cycles
+                   << " cycles, overlap " << stalled.max_overlap << ", kinetic " << stalled.kinetic_energy << " of "
+                   << stalled.artificial_energy << " J");
+  CHECK(stalled.end == crusher::FreezeEnd::Stalled);
+  CHECK(std::string(crusher::freezeEndName(stalled.end)) == "stalled");
+  // What the walls allow (0.005), nearly: the last approach to rest under local
+  // damping is a creep (the damped force is 0.1 of a spring force that vanishes at
+  // rest) slower than 1 % per window, so the rule ends it a little above.
+  CHECK(stalled.max_overlap >= 0.005 * 0.999);
+  CHECK(stalled.max_overlap < 0.005 * 1.25);
+  CHECK(stalled.kinetic_energy <= settings.kinetic_fraction * stalled.artificial_energy);
+  CHECK(stalled.stall_window_cycles > 1000);  // the window is the fragments' time, not a handful of cycles
+  CHECK(stalled.cycles < 6 * stalled.stall_window_cycles);  // a few windows, not the cap
+  CHECK(stalled.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 20);
+  const sim::ParticleState& p = pinched.state.particles;
+  CHECK(2 * p.radius[0] - (p.position[1] - p.position[0]).norm() == Approx(stalled.max_overlap * 0.005));  // kept
+
+  // The same row without the walls: the pair pushes itself and the ball apart and
+  // meets the overlap criterion (the stall rule must not end it while the fragments
+  // are still getting under way).
+  FreezeCase free = fragmentRow(2e-3, std::nullopt);
+  const crusher::FreezeResult converged = crusher::freezeFragments(free.model, free.state, fragments, settings, 1);
+  INFO("free: " << converged.cycles << " cycles, overlap " << converged.max_overlap);
+  CHECK(converged.end == crusher::FreezeEnd::Converged);
+  CHECK(converged.max_overlap <= settings.overlap_fraction);
+
+  // Tight: 2 mm (0.4) at the split, 1.25 mm (0.25) kept, above
+  // freeze_stall_max_overlap: no stall, the freeze runs into freeze_max_cycles;
+  // with the bound raised it stalls there.
+  crusher::FreezeSettings capped = settings;
+  capped.max_cycles = static_cast<std::int64_t>(4 * stalled.cycles);
+  FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
+  CHECK_THROWS_WITH(crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1),
+                    Contains("freeze_max_cycles") && Contains("freeze_stall_max_overlap = 0.01"));
+  capped.stall_max_overlap = 0.3;
+  tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult deep = crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
+  CHECK(deep.end == crusher::FreezeEnd::Stalled);
+  CHECK(deep.max_overlap > 0.2);
+  CHECK(deep.max_overlap <= 0.25 * 1.001);
+
+  // Without the stall rule the snug row runs into freeze_max_cycles, as before.
+  crusher::FreezeSettings no_stall = settings;
+  no_stall.stall_window = 0;
+  no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
+  FreezeCase again = fragmentRow(1e-4, 25e-6);
+  CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
+                    Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
+}
+
 TEST_CASE("breakage settings: off by default, keys checked by name, and a step too long for the smallest fragment "
           "stops the run as bad input",
           "[scene][crusher]") {
@@ -235,6 +345,9 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
   CHECK_THAT(error("experiment.breakage.mode=\"quad\""), Contains("experiment.breakage.mode"));
   CHECK_THAT(error("experiment.breakage.offsets=[0.5,0]"), Contains("experiment.breakage.offsets") && Contains("needs 3"));
   CHECK_THAT(error("experiment.breakage.freeze_local_damping=1.5"), Contains("freeze_local_damping"));
+  CHECK_THAT(error("experiment.breakage.freeze_stall_tolerance=1"),
+             Contains("experiment.breakage.freeze_stall_tolerance") && Contains("[0, 1)"));
+  CHECK_THAT(error("experiment.breakage.freeze_stall_window=-1"), Contains("experiment.breakage.freeze_stall_window"));
   CHECK_THAT(error("experiment.breakage.q_reff=1"), Contains("q_reff"));
 
   // The tiny run's step (soft contacts) is too long for a 1.9 mm fragment at 70 GPa.
@@ -294,8 +407,11 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
     const auto& balance = b["mass_balance"];
     CHECK(balance["feed_kg"].get<double>() ==
           Approx(balance["product_kg"].get<double>() + balance["in_chamber_kg"].get<double>()).epsilon(1e-14));
+    CHECK(b["freezes_converged"].get<int>() + b["freezes_stalled"].get<int>() == b["freezes"].get<int>());
+    CHECK(b["max_freeze_overlap_fraction"].get<double>() >= 0);
     const std::string events = test::slurp(out / "breakage.csv");
     CHECK(std::count(events.begin(), events.end(), '\n') == 1 + b["events"].get<int>());
+    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction\n"));
     if (threads == 1)
       first_events = events;
     else

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -69,7 +70,35 @@ double kineticEnergy(const sim::ParticleState& p) {
   return e;
 }
 
+/// Whether the largest overlap has stopped falling: the samples (cycle, overlap)
+/// of the last `window` cycles, the oldest at or before its start.
+class OverlapStall {
+ public:
+  OverlapStall(std::uint64_t window, double tolerance) : window_(window), tolerance_(tolerance) {}
+  /// Adds the sample of `cycle`; true when the window is full and no sample in it
+  /// fell below (1 - tolerance) of the first.
+  bool stalled(std::uint64_t cycle, double overlap) {
+    if (window_ == 0) return false;
+    samples_.push_back({cycle, overlap});
+    while (samples_.size() >= 2 && samples_[1].cycle + window_ <= cycle) samples_.pop_front();
+    if (samples_.front().cycle + window_ > cycle) return false;
+    const double floor = (1 - tolerance_) * samples_.front().overlap;
+    return std::all_of(samples_.begin(), samples_.end(), [&](const Sample& s) { return s.overlap >= floor; });
+  }
+
+ private:
+  struct Sample {
+    std::uint64_t cycle;
+    double overlap;
+  };
+  std::uint64_t window_;
+  double tolerance_;
+  std::deque<Sample> samples_;
+};
+
 }  // namespace
+
+const char* freezeEndName(FreezeEnd end) { return end == FreezeEnd::Stalled ? "stalled" : "converged"; }
 
 FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
                                   const std::vector<std::uint32_t>& fragments) {
@@ -105,13 +134,24 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
   frozen.half_kick_pending = true;
   sim::World world(m, std::move(frozen), threads);
   result.artificial_energy = fragmentOverlaps(m, world.particles(), fragments).energy;
+  double heaviest = 0;  // kg, at the freeze density
+  for (const std::uint32_t f : fragments) heaviest = std::max(heaviest, world.particles().mass[f]);
+  if (s.stall_window > 0)
+    result.stall_window_cycles =
+        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(s.stall_window * std::sqrt(heaviest / s.stiffness) / result.dt)));
+  OverlapStall stall(result.stall_window_cycles, s.stall_tolerance);
   for (;;) {
     if (result.cycles % static_cast<std::uint64_t>(s.check_cycles) == 0) {
       result.max_overlap = fragmentOverlaps(m, world.particles(), fragments).max_fraction;
       result.kinetic_energy = kineticEnergy(world.particles());
-      if (result.max_overlap <= s.overlap_fraction &&
-          result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy)
+      const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;
+      const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample
+      // The overlap criterion first: a freeze that can converge ends as converged.
+      if (at_rest && result.max_overlap <= s.overlap_fraction) break;
+      if (at_rest && stalled && result.max_overlap <= s.stall_max_overlap) {
+        result.end = FreezeEnd::Stalled;
         break;
+      }
       if (result.cycles >= static_cast<std::uint64_t>(s.max_cycles)) {
         std::ostringstream msg;
         msg << "experiment.breakage: the freeze after breakage at t = " << state.time << " s did not end within "
@@ -120,7 +160,11 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
             << ") and the kinetic energy " << result.kinetic_energy << " J is "
             << result.kinetic_energy / result.artificial_energy << " of the fragments' initial "
             << result.artificial_energy << " J (freeze_kinetic_fraction = " << s.kinetic_fraction
-            << "); raise freeze_max_cycles or relax the criterion (the fragments may have no room to separate)";
+            << ") and it has not stalled (freeze_stall_tolerance = " << s.stall_tolerance
+            << " over freeze_stall_window = " << s.stall_window << " fragment time scales, "
+            << result.stall_window_cycles << " cycles, at an overlap of at most freeze_stall_max_overlap = "
+            << s.stall_max_overlap
+            << "); raise freeze_max_cycles or relax the criteria";
         throw std::runtime_error(msg.str());
       }
     }

@@ -41,6 +41,9 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   f.local_damping = b->number("freeze_local_damping", f.local_damping, {0.0, 1.0, false, true});
   f.overlap_fraction = b->number("freeze_overlap_fraction", f.overlap_fraction, Range::nonNegative());
   f.kinetic_fraction = b->number("freeze_kinetic_fraction", f.kinetic_fraction, Range::nonNegative());
+  f.stall_tolerance = b->number("freeze_stall_tolerance", f.stall_tolerance, {0.0, 1.0, false, true});
+  f.stall_window = b->number("freeze_stall_window", f.stall_window, Range::closed(0.0, 1e6));
+  f.stall_max_overlap = b->number("freeze_stall_max_overlap", f.stall_max_overlap, Range::nonNegative());
   f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
   f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
   b->finish();
@@ -159,13 +162,28 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     events_.push_back(std::move(e));
   }
   const crusher::FreezeResult freeze = crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads);
-  for (std::size_t k = first_event; k < events_.size(); ++k) events_[k].freeze_cycles = freeze.cycles;
+  for (std::size_t k = first_event; k < events_.size(); ++k) {
+    events_[k].freeze_cycles = freeze.cycles;
+    events_[k].freeze_end = freeze.end;
+    events_[k].freeze_overlap = freeze.max_overlap;
+  }
   fragments_created_ += rows.size();
   ++freezes_;
+  if (freeze.end == crusher::FreezeEnd::Stalled) ++freezes_stalled_;
+  max_freeze_overlap_ = std::max(max_freeze_overlap_, freeze.max_overlap);
   freeze_cycles_ += freeze.cycles;
   max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
   world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
   return true;
+}
+
+std::string CrusherBreakage::progress() const {
+  std::ostringstream s;
+  s << events_.size() << " broken";
+  if (freezes_ > 0)
+    s << ", freezes " << freezes_ - freezes_stalled_ << " converged " << freezes_stalled_ << " stalled (overlap left <= "
+      << max_freeze_overlap_ << ", " << freeze_cycles_ << " cycles)";
+  return s.str();
 }
 
 nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, const std::filesystem::path& out_dir) const {
@@ -183,12 +201,13 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   }
   std::ostringstream csv;
   csv.precision(17);
-  csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles\n";
+  csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles,freeze_end,"
+         "freeze_overlap_fraction\n";
   for (const BreakageEvent& e : events_) {
     csv << e.time << ',' << e.parent << ',' << e.diameter * 1e3 << ',' << e.q * 1e-6 << ',' << e.strength * 1e-6 << ','
         << crusher::modeName(s_.mode) << ',';
     for (std::size_t k = 0; k < e.fragments.size(); ++k) csv << (k ? ";" : "") << e.fragments[k];
-    csv << ',' << e.freeze_cycles << '\n';
+    csv << ',' << e.freeze_cycles << ',' << crusher::freezeEndName(e.freeze_end) << ',' << e.freeze_overlap << '\n';
   }
   detail::writeAtomically(out_dir / "breakage.csv", csv.str());
   nlohmann::json b;
@@ -198,6 +217,9 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freezes"] = freezes_;
   b["freeze_cycles"] = freeze_cycles_;
   b["max_freeze_cycles"] = max_freeze_cycles_;
+  b["freezes_converged"] = freezes_ - freezes_stalled_;
+  b["freezes_stalled"] = freezes_stalled_;
+  b["max_freeze_overlap_fraction"] = max_freeze_overlap_;
   b["mode"] = crusher::modeName(s_.mode);
   b["offsets"] = s_.offsets;
   b["strength"] = {{"q_ref_MPa", s_.strength.q_ref * 1e-6}, {"d_ref_mm", s_.strength.d_ref * 1e3},

@@ -46,7 +46,11 @@ struct BreakageEvent {
   double diameter = 0;               // m
   double q = 0, strength = 0;        // Pa
   std::vector<std::uint64_t> fragments;  // ids
-  std::uint64_t freeze_cycles = 0;   // of the freeze that followed (shared by the events of one check)
+  // The freeze that followed (shared by the events of one check): its cycles, how
+  // it ended and the largest fragment overlap it left (fraction of the smaller radius).
+  std::uint64_t freeze_cycles = 0;
+  crusher::FreezeEnd freeze_end = crusher::FreezeEnd::Converged;
+  double freeze_overlap = 0;
 };
 
 class CrusherBreakage {
@@ -60,6 +64,9 @@ class CrusherBreakage {
   bool check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx);
 
   const std::vector<BreakageEvent>& events() const { return events_; }
+  /// For the progress line: the events and how the freezes so far ended (the
+  /// report is written only at the end of a run).
+  std::string progress() const;
   std::size_t fragmentsCreated() const { return fragments_created_; }
   /// results.json's crusher.breakage (without the mass balance, which the driver
   /// adds) and breakage.csv.
@@ -79,6 +86,8 @@ class CrusherBreakage {
   std::vector<BreakageEvent> events_;
   std::size_t fragments_created_ = 0;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
+  std::uint64_t freezes_stalled_ = 0;
+  double max_freeze_overlap_ = 0;  // the largest overlap fraction a freeze left
 };
 
 }  // namespace rocklab::experiments

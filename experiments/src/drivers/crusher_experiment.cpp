@@ -72,7 +72,7 @@ class CrusherRunExperiment final : public Experiment {
   std::string progress() const override {
     std::ostringstream s;
     s << product_.size() << " balls discharged";
-    if (e_.breakage.enabled) s << ", " << breakage_.events().size() << " broken";
+    if (e_.breakage.enabled) s << ", " << breakage_.progress();
     return s.str();
   }
 

@@ -295,7 +295,10 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "freeze_local_damping", "", "Local damping alpha during the freeze (§g.6 step 5; viscous damping off)."},
       {"experiment.crusher.breakage", "freeze_overlap_fraction", "", "The freeze may end when no fragment overlaps a ball by more than this fraction of the smaller radius."},
       {"experiment.crusher.breakage", "freeze_kinetic_fraction", "", "...and the kinetic energy is below this fraction of the energy the fragments' overlaps stored at the freeze stiffness."},
-      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended after this many cycles stops the run (with the criterion's values)."},
+      {"experiment.crusher.breakage", "freeze_stall_tolerance", "", "The freeze also ends (\"stalled\") when the kinetic criterion holds and the largest fragment overlap has not fallen below (1 - this) of its value freeze_stall_window ago: fragments pinched between the held walls or heavy neighbours, whose overlap cannot reach freeze_overlap_fraction."},
+      {"experiment.crusher.breakage", "freeze_stall_window", "", "The window of the stall rule in the heaviest fragment's time scale sqrt(m/k) at the freeze density and stiffness (not in cycles: the freeze's step is set by the unbroken balls); 0 = no stall rule (only the overlap criterion ends a freeze)."},
+      {"experiment.crusher.breakage", "freeze_stall_max_overlap", "", "The stall rule ends a freeze only when the largest fragment overlap is at most this fraction of the smaller radius (higher plateaus are squeezes the fragments leave later; handed back at rock stiffness they would fire the fragments apart)."},
+      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles stops the run (with the criteria's values)."},
       {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
@@ -574,7 +577,10 @@ freeze_stiffness = 1e3
 freeze_local_damping = 0.9
 freeze_overlap_fraction = 1e-4
 freeze_kinetic_fraction = 0.2
-freeze_max_cycles = 200000
+freeze_stall_tolerance = 0.01
+freeze_stall_window = 2
+freeze_stall_max_overlap = 0.01
+freeze_max_cycles = 1000000
 freeze_check_cycles = 20
 )",
 };
