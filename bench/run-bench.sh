@@ -135,10 +135,11 @@ done
 # Clumps: N four-ball clumps in a W x W box (W grows as sqrt(N): the same 0.1 m high insertion
 # region at a solid fraction of 0.15), SETTLE steps on a fixed floor, then SHEAR steps on a floor
 # sliding at 0.5 m/s. Throughput in ball-steps/s (4 balls a clump: rocklab's particle_steps_per_s,
-# LIGGGHTS' atoms x steps / loop time); the check is touching member pairs of different clumps per
-# clump at the last step, in each engine.
+# LIGGGHTS' atoms x steps / loop time); the check, from each engine at the last step: touching
+# member pairs of different clumps per clump, and the mean height of the clumps' centres (mm;
+# rocklab: its gravitational energy / (total mass x g)).
 if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
-  printf '\nscene,clumps,balls,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,contacts_per_clump_rocklab,contacts_per_clump_liggghts\n'
+  printf '\nscene,clumps,balls,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,contacts_per_clump_rocklab,contacts_per_clump_liggghts,mean_height_mm_rocklab,mean_height_mm_liggghts\n'
   specs=("1700 0.72 30000 20000" "12000 1.913 30000 20000")  # N, W (m), SETTLE, SHEAR
   [ "$sizes" = full ] || specs=("${specs[0]}")
   for spec in "${specs[@]}"; do
@@ -151,20 +152,24 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
           --set "walls.xmax.point=[$w,0,0]" --set "walls.ymax.point=[0,$w,0]"
           --set "walls.floor.active_until=$switch" --set "walls.shear_floor.active_from=$switch")
     run_rocklab clumps $nc 1 $((steps + 1)) "${args[@]}"; r1=$ps; touch_r=$touch
+    res="$out/rocklab-clumps-$nc-1/results.json"
+    height_r=$(echo "1000 * $(json "$res" potential_gravity) / ($nc * $(json "$res" mass_kg) * 9.81)" | bc -l)
     run_rocklab clumps $nc 2 $((steps + 1)) "${args[@]}"; r2=$ps
     # rocklab's rate is over its particles_at_start balls: the same n.
-    touch_l=""
+    touch_l=""; height_l=""
     run_peer clumps $n 1 "$steps" N $nc W $w SETTLE $settle SHEAR $shear; l1=$pps
-    # the last thermo line (step atoms ke cpc cpu): cpc = member contacts per clump
-    [ -z "$l1" ] || touch_l=$(awk 'NF == 5 && $1 ~ /^[0-9]+$/ && $2 ~ /^[0-9]+$/ { c = $4 } END { print c }' "$peer_log")
+    # the last thermo line (step atoms ke cpc cz cpu): member contacts per clump, mean height (m)
+    if [ -n "$l1" ]; then
+      read -r touch_l height_l < <(awk 'NF == 6 && $1 ~ /^[0-9]+$/ && $2 ~ /^[0-9]+$/ { c = $4; z = $5 } END { print c, 1000 * z }' "$peer_log")
+    fi
     run_peer clumps $n 2 "$steps" N $nc W $w SETTLE $settle SHEAR $shear; l2=$pps
     ratio1=""; ratio2=""
     [ -z "$l1" ] || ratio1=$(echo "$r1 / $l1" | bc -l)
     [ -z "$l2" ] || ratio2=$(echo "$r2 / $l2" | bc -l)
-    printf 'clumps,%d,%d,%d,%.3g,%.3g,%.2f,%s,%s,%s,%s,%.2f,%s\n' $nc $n $steps "$r1" "$r2" "$(echo "$r2 / $r1" | bc -l)" \
+    printf 'clumps,%d,%d,%d,%.3g,%.3g,%.2f,%s,%s,%s,%s,%.3f,%s,%.1f,%s\n' $nc $n $steps "$r1" "$r2" "$(echo "$r2 / $r1" | bc -l)" \
       "$( [ -z "$l1" ] || printf %.3g "$l1")" "$( [ -z "$l2" ] || printf %.3g "$l2")" \
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$touch_r" \
-      "$( [ -z "$touch_l" ] || printf %.2f "$touch_l")"
+      "$( [ -z "$touch_l" ] || printf %.3f "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
   done
 fi
 
