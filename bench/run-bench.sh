@@ -166,10 +166,10 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
     ratio1=""; ratio2=""
     [ -z "$l1" ] || ratio1=$(echo "$r1 / $l1" | bc -l)
     [ -z "$l2" ] || ratio2=$(echo "$r2 / $l2" | bc -l)
-    printf 'clumps,%d,%d,%d,%.3g,%.3g,%.2f,%s,%s,%s,%s,%.3f,%s,%.1f,%s\n' $nc $n $steps "$r1" "$r2" "$(echo "$r2 / $r1" | bc -l)" \
+    printf 'clumps,%d,%d,%d,%.3g,%.3g,%.2f,%s,%s,%s,%s,%.3g,%s,%.1f,%s\n' $nc $n $steps "$r1" "$r2" "$(echo "$r2 / $r1" | bc -l)" \
       "$( [ -z "$l1" ] || printf %.3g "$l1")" "$( [ -z "$l2" ] || printf %.3g "$l2")" \
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$touch_r" \
-      "$( [ -z "$touch_l" ] || printf %.3f "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
+      "$( [ -z "$touch_l" ] || printf %.3g "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
   done
 fi
 
