@@ -3,21 +3,28 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|grid|render|track|memory|all] [small|full] [OUTDIR]
-#   scene  settle (contact-sparse), dense (contact-rich), grid (7:1 size ratio:
+# Usage: bench/run-bench.sh [settle|dense|clumps|grid|render|track|memory|all] [small|full] [OUTDIR]
+#   scene  settle (contact-sparse), dense (contact-rich), clumps (the chute's four-ball clump
+#          landing in a box, then sheared by a sliding floor; ball-steps/s, i.e. clump members,
+#          and member contacts per clump in both engines as the check), grid (7:1 size ratio:
 #          multi-level against single-level neighbour grid, rocklab only), render
 #          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
 #          1280x1024, rocklab only), track (marker detection + linking frames/s on
 #          the same frames), memory (rocklab's peak-RSS growth per sphere on settle
 #          and dense, N = 2000 to 54000, one thread, 200 steps: not a timing, so it
 #          may run beside other work) or all (default: every timing, not memory)
-#   sizes  small: N = 2000 only; full (default): N = 2000, 16000, 54000
+#   sizes  small: N = 2000 only (clumps: 1,700 clumps); full (default): N = 2000, 16000, 54000
+#          (clumps: 1,700 and 12,000 clumps, 6,800 and 48,000 balls)
 #   OUTDIR logs and results (default: a new temporary directory)
 # Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install
 # --no-install-recommends liggghts` (with its recommends apt removes libvtk9-dev for
 # ParaView, and rocklab no longer configures).
 # Both engines run the same lattice, walls, contact law (linear, 1e9 N/m per contact,
 # friction 0.37, tangential history, no damping), dt = 1e-6 s, skin 2 mm and step count.
+# The clumps scene has the same clump (members, mass, principal moments), box, insertion region,
+# law (plus a normal dashpot, so that a bed forms), dt and phases in both, but each engine inserts
+# with its own random stream: the two agree statistically (docs/performance.md), hence the check
+# column from both.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 rocklab="${ROCKLAB_BIN:-$root/build/app/rocklab}"  # ROCKLAB_BIN: another build (old against new)
@@ -49,14 +56,17 @@ run_rocklab() {  # scene n threads steps args... -> sets ps (particle-steps/s), 
   touch=$(echo "$contacts / $n" | bc -l)
 }
 
-run_peer() {  # scene n procs steps NX NY NZ -> sets pps
-  local scene=$1 n=$2 np=$3 steps=$4
+run_peer() {  # scene n procs steps [VAR VALUE]... -> sets pps (n x steps / s), peer_log
+  local scene=$1 n=$2 np=$3 steps=$4; shift 4
   pps=""
   [ $have_peer = 1 ] || return 0
-  local log="$out/liggghts-$scene-$n-$np.log"
+  peer_log="$out/liggghts-$scene-$n-$np.log"
+  local vars=()
+  while [ $# -ge 2 ]; do vars+=(-var "$1" "$2"); shift 2; done
   (cd "$out" && mpirun --allow-run-as-root --oversubscribe -np "$np" liggghts -in "$root/bench/liggghts/$scene.liggghts" \
-    -var NX "$5" -var NY "$6" -var NZ "$7" -var STEPS "$steps" -log none >"$log" 2>&1)
-  local t; t=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on.*/\1/p' "$log" | tail -1)
+    "${vars[@]}" -log none >"$peer_log" 2>&1)
+  # Loop time of every run but a one-step one (the clumps' insertion step, not timed in rocklab either).
+  local t; t=$(awk '/^Loop time of/ && $9 > 1 { s += $4 } END { print s }' "$peer_log")
   pps=$(echo "$n * $steps / $t" | bc -l)
 }
 
@@ -92,7 +102,9 @@ if [ "$which_scenes" = memory ]; then
   exit 0
 fi
 
-printf 'scene,N,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,rocklab_bytes_per_particle,touching_pairs_per_sphere\n'
+case $which_scenes in all|settle|dense)
+  printf 'scene,N,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,rocklab_bytes_per_particle,touching_pairs_per_sphere\n' ;;
+esac
 for scene in settle dense; do
   [ "$which_scenes" = all ] || [ "$which_scenes" = "$scene" ] || continue
   case $scene in
@@ -107,8 +119,8 @@ for scene in settle dense; do
     box_args $scene $nx $ny $nz
     run_rocklab $scene $n 1 "$steps" "${args[@]}"; r1=$ps; rss1=$rss
     run_rocklab $scene $n 2 "$steps" "${args[@]}"; r2=$ps
-    run_peer $scene $n 1 "$steps" $nx $ny $nz; l1=$pps
-    run_peer $scene $n 2 "$steps" $nx $ny $nz; l2=$pps
+    run_peer $scene $n 1 "$steps" NX $nx NY $ny NZ $nz STEPS "$steps"; l1=$pps
+    run_peer $scene $n 2 "$steps" NX $nx NY $ny NZ $nz STEPS "$steps"; l2=$pps
     # Memory per particle: growth of peak RSS from the smallest size (removes the fixed cost).
     if [ -z "$rss_small" ]; then rss_small=$rss1; n_small=$n; bpp=""; else bpp=$(echo "($rss1 - $rss_small) / ($n - $n_small)" | bc); fi
     ratio1=""; ratio2=""
@@ -119,6 +131,47 @@ for scene in settle dense; do
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$bpp" "$touch"
   done
 done
+
+# Clumps: N four-ball clumps in a W x W box (W grows as sqrt(N): the same 0.1 m high insertion
+# region at a solid fraction of 0.15), SETTLE steps on a fixed floor, then SHEAR steps on a floor
+# sliding at 0.5 m/s. Throughput in ball-steps/s (4 balls a clump: rocklab's particle_steps_per_s,
+# LIGGGHTS' atoms x steps / loop time); the check, from each engine at the last step: touching
+# member pairs of different clumps per clump, and the mean height of the clumps' centres (mm;
+# rocklab: its gravitational energy / (total mass x g)).
+if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
+  printf '\nscene,clumps,balls,steps,rocklab_1t,rocklab_2t,speedup_2t,liggghts_1p,liggghts_2p,ratio_1core,ratio_2core,contacts_per_clump_rocklab,contacts_per_clump_liggghts,mean_height_mm_rocklab,mean_height_mm_liggghts\n'
+  specs=("1700 0.72 30000 20000" "12000 1.913 30000 20000")  # N, W (m), SETTLE, SHEAR
+  [ "$sizes" = full ] || specs=("${specs[0]}")
+  for spec in "${specs[@]}"; do
+    set -- $spec
+    nc=$1 w=$2 settle=$3 shear=$4 n=$((4 * $1)) steps=$(($3 + $4))
+    # rocklab runs the peer's insertion step too (steps + 1); the floors swap after step
+    # settle + 1 as in the peer (to within a step: the switch time lies between two steps).
+    switch=$(calc "($settle + 0.5) * 0.000001")  # bc reads no exponent
+    args=(--set "particles.0.count=$nc" --set "particles.0.region_max=[$w,$w,0.1]"
+          --set "walls.xmax.point=[$w,0,0]" --set "walls.ymax.point=[0,$w,0]"
+          --set "walls.floor.active_until=$switch" --set "walls.shear_floor.active_from=$switch")
+    run_rocklab clumps $nc 1 $((steps + 1)) "${args[@]}"; r1=$ps; touch_r=$touch
+    res="$out/rocklab-clumps-$nc-1/results.json"
+    height_r=$(echo "1000 * $(json "$res" potential_gravity) / ($nc * $(json "$res" mass_kg) * 9.81)" | bc -l)
+    run_rocklab clumps $nc 2 $((steps + 1)) "${args[@]}"; r2=$ps
+    # rocklab's rate is over its particles_at_start balls: the same n.
+    touch_l=""; height_l=""
+    run_peer clumps $n 1 "$steps" N $nc W $w SETTLE $settle SHEAR $shear; l1=$pps
+    # the last thermo line (step atoms ke cpc cz cpu): member contacts per clump, mean height (m)
+    if [ -n "$l1" ]; then
+      read -r touch_l height_l < <(awk 'NF == 6 && $1 ~ /^[0-9]+$/ && $2 ~ /^[0-9]+$/ { c = $4; z = $5 } END { print c, 1000 * z }' "$peer_log")
+    fi
+    run_peer clumps $n 2 "$steps" N $nc W $w SETTLE $settle SHEAR $shear; l2=$pps
+    ratio1=""; ratio2=""
+    [ -z "$l1" ] || ratio1=$(echo "$r1 / $l1" | bc -l)
+    [ -z "$l2" ] || ratio2=$(echo "$r2 / $l2" | bc -l)
+    printf 'clumps,%d,%d,%d,%.3g,%.3g,%.2f,%s,%s,%s,%s,%.3g,%s,%.1f,%s\n' $nc $n $steps "$r1" "$r2" "$(echo "$r2 / $r1" | bc -l)" \
+      "$( [ -z "$l1" ] || printf %.3g "$l1")" "$( [ -z "$l2" ] || printf %.3g "$l2")" \
+      "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$touch_r" \
+      "$( [ -z "$touch_l" ] || printf %.3g "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
+  done
+fi
 
 # Neighbour grid at a 7:1 size ratio: the multi-level grid against one level whose
 # cells are sized by the largest sphere (neighbours.max_levels = 1).
