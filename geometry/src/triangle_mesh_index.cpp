@@ -128,6 +128,35 @@ bool TriangleMeshIndex::closestPointWithin(const Vec3& p, double radius, Vec3& c
   return found;
 }
 
+void TriangleMeshIndex::trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const {
+  const Tree& t = *tree_;
+  const std::size_t first = out.size();
+  const double r2 = radius * radius;
+  forTrianglesNear(t.tree, t.triangles, p, radius, [&](std::size_t k) {
+    if ((t.closestOn(k, p) - p).squaredNorm() < r2) out.push_back(static_cast<std::uint32_t>(k));
+  });
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+}
+
+bool TriangleMeshIndex::closestPointAmong(const Vec3& p, double radius, std::span<const std::uint32_t> triangles,
+                                          Vec3& closest) const {
+  const Tree& t = *tree_;
+  double best = radius * radius;
+  bool found = false;
+  // In increasing index order a strict < keeps the first triangle of a tie, as
+  // closestPointWithin's tie rule does.
+  for (const std::uint32_t k : triangles) {
+    const Vec3 q = t.closestOn(k, p);
+    const double d2 = (q - p).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      closest = q;
+      found = true;
+    }
+  }
+  return found;
+}
+
 std::vector<TriangleMeshIndex::Touch> TriangleMeshIndex::touches(const Vec3& p, double r) const {
   const Tree& t = *tree_;
   std::vector<std::size_t> near;

@@ -3,6 +3,7 @@
 // principal values (particle_stress.h), and the load on each wall
 // (World::wallForces).
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <numbers>
 
 #include "rocklab/sim/particle_stress.h"
@@ -26,6 +27,14 @@ PrincipalStresses principalStresses(const Mat3& stress) {
 double octahedralShearStress(const PrincipalStresses& s) {
   const double a = s.major - s.intermediate, b = s.intermediate - s.minor, c = s.minor - s.major;
   return std::sqrt(a * a + b * b + c * c) / 3.0;  // Eq 3-15 / 6-10 [R]
+}
+
+double octahedralShearStress(const Mat3& stress) {
+  const Mat3 symmetric = 0.5 * (stress + stress.transpose());
+  const double trace = symmetric.trace();
+  // (s1-s2)^2 + (s2-s3)^2 + (s3-s1)^2 = 3 (s1^2 + s2^2 + s3^2) - (s1 + s2 + s3)^2
+  const double sum_of_squares = std::max(0.0, 3.0 * symmetric.squaredNorm() - trace * trace);
+  return std::sqrt(sum_of_squares) / 3.0;  // Eq 3-15 / 6-10 [R]
 }
 
 namespace {
@@ -69,7 +78,7 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       if (!history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
       ContactPoint touch;
-      if (!ballWallTouch(walls_now[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
+      if (!ballWallTouch(walls_now[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch)) continue;
       const double overlap = wallOverlap(touch, c);
       if (overlap <= 0) continue;
       double secant, tangent;

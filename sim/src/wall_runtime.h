@@ -7,7 +7,10 @@
 // skip both maps; a wall that only spins (model.h WallMotion) has a velocity but
 // no pose change.
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <span>
+#include <vector>
 
 #include "rocklab/geometry/closest_point.h"
 #include "rocklab/geometry/triangle_mesh_index.h"
@@ -76,8 +79,22 @@ class WallRuntime {
     return distance(w, x) < range;
   }
 
-  /// Contact of a ball (centre x, radius r) with the wall; false when apart.
-  bool contact(const Wall& w, const Vec3& x, double r, WallContact& out) const {
+  bool isMesh(const Wall& w) const { return w.shape == WallShape::Mesh; }
+
+  /// Mesh walls: appends the triangles nearer to x than `range` (increasing), a
+  /// ball's candidates until the next neighbour build; false when there are none.
+  bool nearTriangles(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& out) const {
+    const std::size_t before = out.size();
+    if (w.shape == WallShape::Mesh) mesh_index_.trianglesWithin(toBody(x), range, out);
+    return out.size() > before;
+  }
+
+  /// Contact of a ball (centre x, radius r) with the wall; false when apart. A
+  /// mesh wall looks only at `triangles`, the ball's candidates of the last
+  /// neighbour build (nearTriangles with r + skin): the same contact as a search
+  /// of the whole mesh while the ball and the wall have moved less than the skin.
+  bool contact(const Wall& w, const Vec3& x, double r, std::span<const std::uint32_t> triangles,
+               WallContact& out) const {
     const Vec3 xb = toBody(x);
     if (w.shape == WallShape::Plane) {
       // One-sided: a ball behind the plane is still pushed out along its normal.
@@ -89,7 +106,7 @@ class WallRuntime {
     }
     Vec3 q;
     if (w.shape == WallShape::Mesh) {
-      if (!mesh_index_.closestPointWithin(xb, r, q)) return false;  // visits only the triangles near the ball
+      if (!mesh_index_.closestPointAmong(xb, r, triangles, q)) return false;
     } else {
       q = closestInBody(w, xb);
     }

@@ -94,10 +94,12 @@ struct ContactPoint {
 }
 
 /// A ball against an active wall; false when apart or the wall is not there.
+/// `triangles`: a mesh wall's candidate triangles for this ball (NeighbourLists).
 [[gnu::always_inline]] inline bool ballWallTouch(const detail::WallRuntime& runtime, const Wall& wall,
-                                                 const Vec3& xi, double ri, ContactPoint& g) {
+                                                 const Vec3& xi, double ri, std::span<const std::uint32_t> triangles,
+                                                 ContactPoint& g) {
   detail::WallContact wc;
-  if (!runtime.active || !runtime.contact(wall, xi, ri, wc)) return false;
+  if (!runtime.active || !runtime.contact(wall, xi, ri, triangles, wc)) return false;
   g.normal = wc.normal;
   g.overlap = wc.overlap;
   g.point = xi + g.normal * (ri - 0.5 * g.overlap);
@@ -171,6 +173,14 @@ struct World::Impl {
     detail::PairList pairs;                  // ball–ball pairs, canonical CSR
     std::vector<std::uint32_t> wall_offset;  // [n+1] ball–wall candidates in rows by ball
     std::vector<std::uint32_t> wall_index;   // [k] wall of each candidate
+    // Mesh walls: candidate k's triangles within r + skin at the build are
+    // wall_triangles[wall_triangle_offset[k] .. [k+1]] (empty for other walls).
+    std::vector<std::uint32_t> wall_triangle_offset;  // [k+1]
+    std::vector<std::uint32_t> wall_triangles;
+    std::span<const std::uint32_t> trianglesOf(std::uint32_t candidate) const {
+      return {wall_triangles.data() + wall_triangle_offset[candidate],
+              wall_triangles.data() + wall_triangle_offset[candidate + 1]};
+    }
     std::vector<Vec3> ref_position;          // [n] m, positions at the last rebuild
     double skin = 0.0;                       // m
     bool need_rebuild = true;

@@ -140,7 +140,7 @@ TEST_CASE("a ball between two closing walls breaks when q exceeds its strength a
   const BreakageSettings settings = pinchSettings();
   CrusherBreakage breakage(settings, 3);
   const ExperimentContext ctx{1, nullptr};
-  breakage.start(*world, 1e-3);
+  breakage.start(*world);
   const double strength = settings.strength.strength(0.02, crusher::uniformFromId(3, 0));
   double q = 0;
   sim::Energy before;
@@ -206,7 +206,7 @@ TEST_CASE("a freeze that does not end within freeze_max_cycles stops with both c
   settings.freeze.check_cycles = 1;
   CrusherBreakage breakage(settings, 3);
   const ExperimentContext ctx{1, nullptr};
-  breakage.start(*world, 1e-3);
+  breakage.start(*world);
   std::string message;
   try {
     for (int k = 0; k < 20000 && !breakage.check(world, ctx); ++k) world->step();

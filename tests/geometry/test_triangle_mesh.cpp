@@ -51,6 +51,17 @@ TEST_CASE("closest points through the AABB tree equal the brute force", "[geomet
       const bool within = index.closestPointWithin(p, radius, near);
       CHECK(within == ((brute - p).squaredNorm() < radius * radius));
       if (within) CHECK(near == brute);
+      // A neighbour list's candidates (the triangles within radius + a skin, taken
+      // where the point was before it moved by less than the skin) give that point
+      // bit for bit, and miss nothing.
+      const double skin = 0.004;
+      const Vec3 before = p + 0.9 * skin * Vec3(u.x() - 0.5, u.z() - 0.5, u.y() - 0.5).normalized();
+      std::vector<std::uint32_t> candidates;
+      index.trianglesWithin(before, radius + skin, candidates);
+      CHECK(std::is_sorted(candidates.begin(), candidates.end()));
+      Vec3 among = Vec3::Zero();
+      CHECK(index.closestPointAmong(p, radius, candidates, among) == within);
+      if (within) CHECK(among == near);
     }
     INFO("triangles " << mesh.triangleCount());
     CHECK(worst < 1e-12);

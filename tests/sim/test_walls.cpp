@@ -207,7 +207,9 @@ TEST_CASE("a spinning faceted frustum wall: the contact velocity has no spin nor
     const Vec3 radial(std::cos(azimuth), std::sin(azimuth), 0.0);
     const Vec3 centre = Vec3(0, 0, 0.05) + (0.1 + 0.7 * r) * radial;
     sim::detail::WallContact touch;
-    REQUIRE(runtime.contact(mantle, centre, r, touch));
+    std::vector<std::uint32_t> triangles;
+    REQUIRE(runtime.nearTriangles(mantle, centre, r, triangles));
+    REQUIRE(runtime.contact(mantle, centre, r, triangles, touch));
     const Vec3 n = touch.normal;
     const Vec3 point = centre + (r - touch.overlap) * n;
     const Vec3 omega_x_r = spin * Vec3::UnitZ().cross(point);

@@ -26,7 +26,7 @@ namespace rocklab::experiments {
 
 struct BreakageSettings {
   bool enabled = false;        // the table [experiment.breakage] is there
-  double check_interval = 0;   // s between checks; 0 = the experiment's sample_interval
+  double check_interval = 0;   // s between checks; 0 = automatic (automaticCheckInterval)
   crusher::StrengthLaw strength;
   double min_diameter = 0.004;  // m, smaller balls never break (Table 6.2)
   crusher::SplitMode mode = crusher::SplitMode::Triple;
@@ -57,8 +57,9 @@ class CrusherBreakage {
  public:
   CrusherBreakage(BreakageSettings settings, std::uint64_t seed);
   /// Checks the run can break balls (linear law, a step stable for the smallest
-  /// fragment); throws std::invalid_argument naming the keys otherwise.
-  void start(const sim::World& world, double sample_interval);
+  /// fragment) and sets the check interval; throws std::invalid_argument naming
+  /// the keys otherwise.
+  void start(const sim::World& world);
   /// Every check_interval: breaks the balls over their strength and rebuilds the
   /// world after the freeze. Returns whether the world changed.
   bool check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx);
@@ -76,9 +77,16 @@ class CrusherBreakage {
   /// its size class's copy of the feed material (added to `model` when new).
   int fragmentMaterial(sim::Model& model, int material, double diameter);
 
+  /// The default check interval: a quarter of the shortest contact time
+  /// pi sqrt(m / k) a ball that can break has on a wall (a ball of min_diameter of
+  /// each material in `p`, on the stiffer of its material's and its fragment
+  /// class's spring), s.
+  double automaticCheckInterval(const sim::Model& model, const sim::ParticleState& p) const;
+
  private:
   BreakageSettings s_;
   std::uint64_t seed_;
+  double check_interval_ = 0;  // s, the one in use (set or automatic)
   std::uint64_t every_ = 1;
   std::uint64_t next_id_ = 0;
   std::map<int, int> base_of_;                    // fragment material -> the feed material it copies

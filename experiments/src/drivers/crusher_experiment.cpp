@@ -43,7 +43,7 @@ class CrusherRunExperiment final : public Experiment {
       every_ = stepsIn(e_.sample_interval, world->dt());
       for (std::size_t i = 0; i < p.size(); ++i) feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i]});
       chamber_mass_ = massOf(feed_);
-      if (e_.breakage.enabled) breakage_.start(*world, e_.sample_interval);
+      if (e_.breakage.enabled) breakage_.start(*world);
     }
     if (world->particles().size() == 0) return false;  // the chamber is empty
     if (e_.breakage.enabled && breakage_.check(world, ctx)) chamber_mass_ = massOf(world->particles());

@@ -280,7 +280,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
       {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},
       {"experiment.crusher.breakage", "", "", "[experiment.breakage] of type = \"crusher\": population-balance breakage (experiments.md §g.6, docs/crusher.md); off without the table. A ball of at least min_diameter whose octahedral shear stress exceeds its strength is replaced by fragments, which a freeze eases apart."},
-      {"experiment.crusher.breakage", "check_interval", "s", "Time between breakage checks; 0 = the experiment's sample_interval. Impacts shorter than it can be missed."},
+      {"experiment.crusher.breakage", "check_interval", "s", "Time between breakage checks; 0 = automatic: a quarter of the contact time pi sqrt(m/k) of a ball of min_diameter on a wall, so every impact is seen near its peak (results.json: crusher.breakage.check_interval_s)."},
       {"experiment.crusher.breakage", "q_ref", "Pa", "q0 at d_ref: the octahedral shear strength 37 % of the balls of that size exceed (Weibull scale)."},
       {"experiment.crusher.breakage", "d_ref", "m", "Size q_ref belongs to ([I]: 21 mm, the middle of the 14-28 mm feed)."},
       {"experiment.crusher.breakage", "size_exponent", "", "b of the size effect q0(d) = q_ref (d / d_ref)^b (Eq 6-13)."},

@@ -34,7 +34,7 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
       if (!history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
       ContactPoint touch;
-      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch)) continue;
+      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch)) continue;
       e.elastic += detail::elasticEnergy<Law>(wallProps(i, wk), wallOverlap(touch, c), p.radius[i],
                                               history.wall_shear[c]);
     }

@@ -72,7 +72,7 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
     const std::uint32_t wk = nb.wall_index[w];
     const detail::WallRuntime& wr = walls[wk];
     ContactPoint touch;
-    if (!ballWallTouch(wr, model.walls[wk], xi, ri, touch)) {
+    if (!ballWallTouch(wr, model.walls[wk], xi, ri, nb.trianglesOf(w), touch)) {
       history.wall_touch[w] = 0;
       history.wall_shear[w].setZero();
       if (relax.active()) relax.wall[w] = 0.0;

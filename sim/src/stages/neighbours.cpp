@@ -54,11 +54,18 @@ void World::Impl::rebuildNeighbours() {
   std::vector<double> old_wrelax = std::move(relax.wall);
   nb.wall_offset.assign(n + 1, 0);
   nb.wall_index.clear();
+  nb.wall_triangle_offset.assign(1, 0);
+  nb.wall_triangles.clear();
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t k = 0; k < walls.size(); ++k) {
       if (!walls[k].active) continue;
-      if (walls[k].within(model.walls[k], p.position[i], p.radius[i] + nb.skin))
-        nb.wall_index.push_back(static_cast<std::uint32_t>(k));
+      const double range = p.radius[i] + nb.skin;
+      const bool near = walls[k].isMesh(model.walls[k])
+                            ? walls[k].nearTriangles(model.walls[k], p.position[i], range, nb.wall_triangles)
+                            : walls[k].within(model.walls[k], p.position[i], range);
+      if (!near) continue;
+      nb.wall_index.push_back(static_cast<std::uint32_t>(k));
+      nb.wall_triangle_offset.push_back(static_cast<std::uint32_t>(nb.wall_triangles.size()));
     }
     nb.wall_offset[i + 1] = static_cast<std::uint32_t>(nb.wall_index.size());
   }

@@ -86,7 +86,7 @@ void World::Impl::visitTouchingContacts(const std::vector<std::int32_t>& body_of
       if (!history.wall_touch[w]) continue;
       const std::uint32_t wk = nb.wall_index[w];
       ContactPoint touch;
-      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], ri, touch)) continue;
+      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], ri, nb.trianglesOf(w), touch)) continue;
       const double overlap = wallOverlap(touch, w);
       if (overlap <= 0) continue;
       add(i, -1, touch.normal, touch.point, touch.point, overlap, ri, p.mass[i], wallProps(i, wk),

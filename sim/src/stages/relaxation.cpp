@@ -20,7 +20,7 @@ void World::Impl::startRelaxation() {
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
       const std::uint32_t wk = nb.wall_index[c];
       ContactPoint touch;
-      if (ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], touch) && touch.overlap > 0) {
+      if (ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch) && touch.overlap > 0) {
         relax.wall[c] = touch.overlap;
         any = true;
       }

@@ -9,7 +9,9 @@
 // closestPointOnTriangle as the brute force, so both give the same point up to
 // round-off (a tie between triangles sharing an edge or vertex is the same point).
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "rocklab/geometry/triangle_mesh.h"
@@ -32,6 +34,16 @@ class TriangleMeshIndex {
   /// point is the brute force's (the first triangle in mesh order on a tie), so a
   /// ball's contact costs a few triangles whatever the mesh.
   bool closestPointWithin(const Vec3& p, double radius, Vec3& closest) const;
+
+  /// Appends to `out`, in increasing order, every triangle nearer to p than
+  /// `radius`: the candidates of a ball for as long as it and the mesh move less
+  /// than the margin `radius` holds beyond the ball (a neighbour list's skin).
+  void trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const;
+  /// closestPointWithin over the given triangles only (increasing indices): the
+  /// same point, when they hold every triangle nearer to p than `radius`, at the
+  /// cost of a few closest-point tests instead of a tree query.
+  bool closestPointAmong(const Vec3& p, double radius, std::span<const std::uint32_t> triangles,
+                         Vec3& closest) const;
 
   /// A point where a ball centred at p touches the surface.
   struct Touch {

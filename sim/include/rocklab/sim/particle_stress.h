@@ -21,4 +21,10 @@ PrincipalStresses principalStresses(const geometry::Mat3& stress);
 /// q = (1/3) sqrt((s1 - s2)^2 + (s2 - s3)^2 + (s3 - s1)^2) (Eq 3-15 / 6-10 [R]), Pa.
 double octahedralShearStress(const PrincipalStresses& s);
 
+/// The same q from the tensor's invariants, without its eigenvalues: the sum of
+/// squared differences of the principal values is 3 tr(S^2) - (tr S)^2 of the
+/// symmetric part S (a breakage check tests every ball's q and needs the
+/// principal directions only of the balls that break).
+double octahedralShearStress(const geometry::Mat3& stress);
+
 }  // namespace rocklab::sim
