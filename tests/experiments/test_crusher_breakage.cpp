@@ -15,6 +15,7 @@
 #include "crusher_support.h"
 #include "drivers/crusher_breakage.h"
 #include "drivers/crusher_experiment.h"
+#include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/sim/particle_stress.h"
 
@@ -320,6 +321,21 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
   FreezeCase again = fragmentRow(1e-4, 25e-6);
   CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
                     Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
+}
+
+TEST_CASE("a stop request during a freeze ends it at once and leaves the state as it was before the breakage",
+          "[crusher]") {
+  // Ctrl-C or SIGTERM in a long freeze (up to 1e6 cycles) must not wait for it:
+  // the run stops with the state before the breakage, which a restart breaks again.
+  FreezeCase row = fragmentRow(2e-3, std::nullopt);
+  const std::vector<Vec3> before = row.state.particles.position;
+  rocklab::experiments::requestStop();
+  const crusher::FreezeResult r = crusher::freezeFragments(row.model, row.state, {0, 1}, crusher::FreezeSettings{}, 1);
+  rocklab::experiments::clearStopRequest();
+  CHECK(r.end == crusher::FreezeEnd::Interrupted);
+  CHECK(r.cycles == 0);
+  CHECK(row.state.particles.position == before);
+  CHECK(std::string(crusher::freezeEndName(r.end)) == "interrupted");
 }
 
 TEST_CASE("breakage settings: off by default, keys checked by name, and a step too long for the smallest fragment "

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rocklab/experiments/run.h"
 #include "rocklab/sim/timestep.h"
 #include "rocklab/sim/wall_motion.h"
 
@@ -98,7 +99,14 @@ class OverlapStall {
 
 }  // namespace
 
-const char* freezeEndName(FreezeEnd end) { return end == FreezeEnd::Stalled ? "stalled" : "converged"; }
+const char* freezeEndName(FreezeEnd end) {
+  switch (end) {
+    case FreezeEnd::Stalled: return "stalled";
+    case FreezeEnd::Interrupted: return "interrupted";
+    case FreezeEnd::Converged: break;
+  }
+  return "converged";
+}
 
 FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
                                   const std::vector<std::uint32_t>& fragments) {
@@ -142,6 +150,10 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
   OverlapStall stall(result.stall_window_cycles, s.stall_tolerance);
   for (;;) {
     if (result.cycles % static_cast<std::uint64_t>(s.check_cycles) == 0) {
+      if (stopRequested()) {
+        result.end = FreezeEnd::Interrupted;
+        return result;  // `state` untouched
+      }
       result.max_overlap = fragmentOverlaps(m, world.particles(), fragments).max_fraction;
       result.kinetic_energy = kineticEnergy(world.particles());
       const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;

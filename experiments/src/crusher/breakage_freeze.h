@@ -45,6 +45,9 @@
 //   - more than max_cycles: the run stops with a message naming the settings (the
 //     default 1e6 is about five times the longest freeze measured, 206,000 cycles).
 //
+//   - a stop request (rocklab::experiments::stopRequested) is looked at with the
+//     criteria: the freeze ends "interrupted" and leaves `state` as it was.
+//
 // Only the positions (and the contact history at them) come back; masses,
 // stiffnesses, damping, gravity, wall motion and velocities are the run's again.
 #include <cstdint>
@@ -67,8 +70,10 @@ struct FreezeSettings {
   std::int64_t check_cycles = 20;  // cycles between looks at the criterion
 };
 
-/// How a freeze ended: both criteria met, or the kinetic one with the overlap stalled.
-enum class FreezeEnd { Converged, Stalled };
+/// How a freeze ended: both criteria met, the kinetic one with the overlap
+/// stalled, or a stop request (Ctrl-C, SIGTERM) before either: the caller then
+/// keeps the state from before the breakage.
+enum class FreezeEnd { Converged, Stalled, Interrupted };
 const char* freezeEndName(FreezeEnd end);
 
 struct FreezeResult {

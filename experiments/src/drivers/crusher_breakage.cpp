@@ -169,6 +169,11 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   state = sim::withoutBalls(std::move(state), remove);
   std::vector<std::uint32_t> rows;
   const std::size_t first_event = events_.size();
+  // A stop request during the freeze leaves the run as it was before this check:
+  // these are put back, and the world is not replaced.
+  const std::uint64_t next_id_before = next_id_;
+  const auto base_of_before = base_of_;
+  const auto class_material_before = class_material_;
   for (const Broken& b : broken) {
     const std::uint32_t i = b.row;
     BreakageEvent e{world->time(), p.id[i], 2 * p.radius[i], b.q, b.strength, {}, 0};
@@ -182,6 +187,13 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     events_.push_back(std::move(e));
   }
   const crusher::FreezeResult freeze = crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads);
+  if (freeze.end == crusher::FreezeEnd::Interrupted) {
+    events_.resize(first_event);
+    next_id_ = next_id_before;
+    base_of_ = base_of_before;
+    class_material_ = class_material_before;
+    return false;
+  }
   for (std::size_t k = first_event; k < events_.size(); ++k) {
     events_[k].freeze_cycles = freeze.cycles;
     events_[k].freeze_end = freeze.end;

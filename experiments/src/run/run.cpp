@@ -18,10 +18,13 @@ void requestStop() {
 bool stopRequested() {
   return g_stop;
 }
+void clearStopRequest() {
+  g_stop = false;
+}
 
 int runScene(const Scene& scene, const RunOptions& options, std::ostream& log) {
   detail::RunTimes times{detail::Clock::now(), {}};
-  g_stop = false;
+  clearStopRequest();
   detail::RunSetup setup;
   if (const int rc = detail::setUpRun(scene, options, log, setup); rc != kExitOk) return rc;
   times.setup_done = detail::Clock::now();

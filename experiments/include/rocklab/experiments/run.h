@@ -44,5 +44,7 @@ int runScene(const Scene& scene, const RunOptions& options, std::ostream& log);
 void requestStop();
 /// True after requestStop() until the next run starts.
 bool stopRequested();
+/// Forgets a stop request (what starting a run does).
+void clearStopRequest();
 
 }  // namespace rocklab::experiments
