@@ -70,28 +70,19 @@ class WallRuntime {
   }
 
   /// Whether x is nearer than `range` to the wall (planes: signed distance, so a
-  /// point behind is near). Meshes visit only the triangles near x.
-  bool within(const Wall& w, const Vec3& x, double range) const {
-    if (w.shape == WallShape::Mesh) {
-      Vec3 q;
-      return mesh_index_.closestPointWithin(toBody(x), range, q);
-    }
-    return distance(w, x) < range;
-  }
-
-  bool isMesh(const Wall& w) const { return w.shape == WallShape::Mesh; }
-
-  /// Mesh walls: appends the triangles nearer to x than `range` (increasing), a
-  /// ball's candidates until the next neighbour build; false when there are none.
-  bool nearTriangles(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& out) const {
-    const std::size_t before = out.size();
-    if (w.shape == WallShape::Mesh) mesh_index_.trianglesWithin(toBody(x), range, out);
-    return out.size() > before;
+  /// point behind is near). A mesh wall also appends the triangles nearer than
+  /// `range` (increasing) to `triangles`: a ball's candidates until the next
+  /// neighbour build (contact()).
+  bool near(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& triangles) const {
+    if (w.shape != WallShape::Mesh) return distance(w, x) < range;
+    const std::size_t before = triangles.size();
+    mesh_index_.trianglesWithin(toBody(x), range, triangles);
+    return triangles.size() > before;
   }
 
   /// Contact of a ball (centre x, radius r) with the wall; false when apart. A
   /// mesh wall looks only at `triangles`, the ball's candidates of the last
-  /// neighbour build (nearTriangles with r + skin): the same contact as a search
+  /// neighbour build (near() with r + skin): the same contact as a search
   /// of the whole mesh while the ball and the wall have moved less than the skin.
   bool contact(const Wall& w, const Vec3& x, double r, std::span<const std::uint32_t> triangles,
                WallContact& out) const {

@@ -59,11 +59,7 @@ void World::Impl::rebuildNeighbours() {
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t k = 0; k < walls.size(); ++k) {
       if (!walls[k].active) continue;
-      const double range = p.radius[i] + nb.skin;
-      const bool near = walls[k].isMesh(model.walls[k])
-                            ? walls[k].nearTriangles(model.walls[k], p.position[i], range, nb.wall_triangles)
-                            : walls[k].within(model.walls[k], p.position[i], range);
-      if (!near) continue;
+      if (!walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles)) continue;
       nb.wall_index.push_back(static_cast<std::uint32_t>(k));
       nb.wall_triangle_offset.push_back(static_cast<std::uint32_t>(nb.wall_triangles.size()));
     }
