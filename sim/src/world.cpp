@@ -100,6 +100,11 @@ void World::addForceContribution(std::shared_ptr<ForceContribution> contribution
 double World::time() const { return impl_->time; }
 std::uint64_t World::stepCount() const { return impl_->step; }
 double World::dt() const { return impl_->dt; }
+double World::movingWallWork() const {
+  double work = impl_->guard.wall_work_carried;
+  for (const double w : impl_->guard.wall_work) work += w;
+  return work;
+}
 const Model& World::model() const { return impl_->model; }
 const ParticleState& World::particles() const { return impl_->p; }
 const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
@@ -120,6 +125,7 @@ WorldState World::exportState() const {
   s.half_kick_pending = w.half_kick_pending;
   s.particles = w.p;
   s.bonds = w.bonds.state;
+  s.moving_wall_work = movingWallWork();
   for (std::size_t i = 0; i + 1 < w.nb.pairs.row_offset.size(); ++i)
     for (std::uint32_t k = w.nb.pairs.row_offset[i]; k < w.nb.pairs.row_offset[i + 1]; ++k)
       if (!w.history.pair_shear[k].isZero(0) || (w.relax.active() && w.relax.pair[k] > 0))

@@ -227,6 +227,7 @@ struct World::Impl {
     // and gross (sum of |dW|); empty when no wall moves. Per ball, so the sums do
     // not depend on the number of threads.
     std::vector<double> wall_work, wall_work_gross;
+    double wall_work_carried = 0.0;  // J before wall_work's last reset (and from the WorldState)
     std::vector<std::uint8_t> wall_moving;  // [walls] 1 when the wall has a prescribed motion
     detail::SpectrumEstimate spectrum;      // fastest network mode, kept between checks
   } guard;

@@ -247,6 +247,7 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
   w.time = state.time;
   w.step = state.step;
   w.half_kick_pending = state.half_kick_pending;
+  w.guard.wall_work_carried = state.moving_wall_work;
   if (w.p.size() > 0) w.audit = auditTimestep(w.model, w.p, w.bonds.state);  // nothing to audit in an empty world
   w.audit.chosen = state.dt;  // the run continues with the step it had
   w.dt = state.dt;

@@ -164,6 +164,19 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
   CHECK(fs::exists(out / "product_size.png"));
   const std::string product = test::slurp(out / "product.csv");
   CHECK(std::count(product.begin(), product.end(), '\n') == 7);  // header + 6 balls
+  // The product statistics: P50 <= P80 within the feed's 8-9 mm; every ball seen
+  // entering the chamber, its residence shorter than the run; the mantle did work.
+  CHECK(c["p50_mm"].get<double>() >= 8.0);
+  CHECK(c["p50_mm"].get<double>() <= c["p80_mm"].get<double>());
+  CHECK(c["p80_mm"].get<double>() <= 9.0);
+  CHECK(c["residence_s"]["balls"] == 6);
+  CHECK(c["residence_s"]["mean"].get<double>() > 0);
+  CHECK(c["residence_s"]["max"].get<double>() < c["last_discharge_s"].get<double>());
+  CHECK(c["throughput_tph"].get<double>() > 0);
+  CHECK(c["power"]["energy_J"].get<double>() > 0);
+  CHECK(c["power_W"] == c["power"]["power_W"]);
+  CHECK(c["breakages"] == 0);
+  CHECK(fs::exists(out / "mantle_power.png"));
   CHECK(fs::exists(out / "vtk/walls.pvd"));
   CHECK(fs::exists(out / "vtk/walls_000001.vtp"));
   fs::remove_all(out);

@@ -76,6 +76,13 @@ TEST_CASE("wall load: a moving platen's load is read where the platen is now, no
   }
   CHECK(loaded > 10);
   CHECK(world.particles().position[0].norm() < 1e-12);  // the ball did not move
+  // The platen's work on the ball: the integral of load x speed, kn / 4 (v t - gap)^2
+  // (each step counts the load of its force pass: to within one step's share).
+  const double reach = v * world.time() - gap;
+  CHECK(std::abs(world.movingWallWork() - 0.25 * kn * reach * reach) < 0.5 * kn * reach * v * dt);
+  // A World rebuilt from the exported state goes on counting from the same total.
+  const sim::World rebuilt(model, world.exportState(), 1);
+  CHECK(rebuilt.movingWallWork() == world.movingWallWork());
 }
 
 TEST_CASE("particle stress: equal principal stresses give q = 0 - q is invariant under rotation",

@@ -103,6 +103,7 @@ const char* freezeEndName(FreezeEnd end) {
   switch (end) {
     case FreezeEnd::Stalled: return "stalled";
     case FreezeEnd::Interrupted: return "interrupted";
+    case FreezeEnd::Crowded: return "crowded";
     case FreezeEnd::Converged: break;
   }
   return "converged";
@@ -165,6 +166,10 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
         break;
       }
       if (result.cycles >= static_cast<std::uint64_t>(s.max_cycles)) {
+        if (s.defer_crowded) {
+          result.end = FreezeEnd::Crowded;
+          return result;  // `state` untouched: the caller keeps the parents
+        }
         std::ostringstream msg;
         msg << "experiment.breakage: the freeze after breakage at t = " << state.time << " s did not end within "
             << "freeze_max_cycles = " << s.max_cycles << " cycles: the largest fragment overlap is "
@@ -176,7 +181,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
             << " over freeze_stall_window = " << s.stall_window << " fragment time scales, "
             << result.stall_window_cycles << " cycles, at an overlap of at most freeze_stall_max_overlap = "
             << s.stall_max_overlap
-            << "); raise freeze_max_cycles or relax the criteria";
+            << "); raise freeze_max_cycles, relax the criteria, or set freeze_defer_crowded = true";
         throw std::runtime_error(msg.str());
       }
     }

@@ -47,6 +47,8 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   f.stall_max_overlap = b->number("freeze_stall_max_overlap", f.stall_max_overlap, Range::nonNegative());
   f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
   f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
+  f.defer_crowded = b->boolean("freeze_defer_crowded", f.defer_crowded);
+  s.defer_time = b->number("defer_time", s.defer_time, Range::positive());
   b->finish();
 }
 
@@ -156,6 +158,8 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   for (std::uint32_t i = 0; i < p.size(); ++i) {
     const double d = 2 * p.radius[i];
     if (d < s_.min_diameter) continue;
+    if (const auto at = deferred_until_.find(p.id[i]); at != deferred_until_.end() && world->time() < at->second)
+      continue;  // its fragments found no room a moment ago
     const double q = sim::octahedralShearStress(stress[i]);
     if (!(q > 0)) continue;
     const double strength = s_.strength.strength(d, crusher::uniformFromId(seed_, p.id[i]));
@@ -177,21 +181,35 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   for (const Broken& b : broken) {
     const std::uint32_t i = b.row;
     BreakageEvent e{world->time(), p.id[i], 2 * p.radius[i], b.q, b.strength, {}, 0};
+    e.mass = p.mass[i];
     for (const crusher::FragmentBall& f :
          crusher::splitBall(p.position[i], p.radius[i], p.mass[i], b.direction, s_.mode, s_.offsets)) {
       const int material = fragmentMaterial(model, p.material[i], 2 * f.radius);
       rows.push_back(
           sim::appendFreeSphere(state.particles, {f.position, p.velocity[i], p.omega[i], f.radius, material}, f.mass, next_id_));
       e.fragments.push_back(next_id_++);
+      e.fragment_diameters.push_back(2 * f.radius);
+      e.fragment_masses.push_back(f.mass);
     }
     events_.push_back(std::move(e));
   }
   const crusher::FreezeResult freeze = crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads);
-  if (freeze.end == crusher::FreezeEnd::Interrupted) {
+  if (freeze.end == crusher::FreezeEnd::Interrupted || freeze.end == crusher::FreezeEnd::Crowded) {
     events_.resize(first_event);
     next_id_ = next_id_before;
     base_of_ = base_of_before;
     class_material_ = class_material_before;
+    if (freeze.end == crusher::FreezeEnd::Crowded) {
+      // No room for the fragments: the parents stay whole for defer_time, then may break again.
+      Deferral d{world->time(), {}, freeze.cycles, freeze.max_overlap};
+      for (const Broken& b : broken) {
+        d.parents.push_back(p.id[b.row]);
+        deferred_until_[p.id[b.row]] = world->time() + s_.defer_time;
+      }
+      freeze_cycles_ += freeze.cycles;
+      max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
+      deferrals_.push_back(std::move(d));
+    }
     return false;
   }
   for (std::size_t k = first_event; k < events_.size(); ++k) {
@@ -212,6 +230,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
 std::string CrusherBreakage::progress() const {
   std::ostringstream s;
   s << events_.size() << " broken";
+  if (!deferrals_.empty()) s << " (" << deferrals_.size() << " deferred)";
   if (freezes_ > 0)
     s << ", freezes " << freezes_ - freezes_stalled_ << " converged " << freezes_stalled_ << " stalled (overlap left <= "
       << max_freeze_overlap_ << ", " << freeze_cycles_ << " cycles)";
@@ -252,6 +271,12 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freezes_converged"] = freezes_ - freezes_stalled_;
   b["freezes_stalled"] = freezes_stalled_;
   b["max_freeze_overlap_fraction"] = max_freeze_overlap_;
+  nlohmann::json deferred = nlohmann::json::array();
+  for (const Deferral& d : deferrals_)
+    deferred.push_back({{"time_s", d.time}, {"parents", d.parents}, {"freeze_cycles", d.cycles},
+                        {"overlap_fraction", d.overlap}});
+  b["deferred"] = deferred;
+  b["defer_time_s"] = s_.defer_time;
   b["check_interval_s"] = check_interval_;
   b["check_interval_from"] = s_.check_interval > 0 ? "experiment.breakage.check_interval"
                                                    : "automatic: a quarter of the shortest contact time of a ball of "

@@ -34,6 +34,9 @@ struct BreakageSettings {
   double youngs_modulus = 70e9;  // Pa, E_c of the fragments' k = 4 R E_c (Eq 6-14)
   double class_ratio = 1.25;     // fragment size classes: diameters min_diameter x ratio^i .. ^(i+1)
   crusher::FreezeSettings freeze;
+  // s a ball whose fragments found no room (a "crowded" freeze) stays whole before
+  // it may break again; a choice of ours, the reference's freeze has no such case.
+  double defer_time = 2e-3;
 };
 
 /// Reads [experiment.breakage] (the `breakage` table of the experiment's table).
@@ -51,6 +54,8 @@ struct BreakageEvent {
   std::uint64_t freeze_cycles = 0;
   crusher::FreezeEnd freeze_end = crusher::FreezeEnd::Converged;
   double freeze_overlap = 0;
+  double mass = 0;  // kg, the parent's
+  std::vector<double> fragment_diameters, fragment_masses;  // m, kg; in the order of `fragments`
 };
 
 class CrusherBreakage {
@@ -92,6 +97,14 @@ class CrusherBreakage {
   std::map<int, int> base_of_;                    // fragment material -> the feed material it copies
   std::map<std::pair<int, int>, int> class_material_;  // (feed material, class) -> material
   std::vector<BreakageEvent> events_;
+  struct Deferral {  // a crowded freeze: its time, parents, cycles and the overlap it left
+    double time = 0;
+    std::vector<std::uint64_t> parents;
+    std::uint64_t cycles = 0;
+    double overlap = 0;
+  };
+  std::vector<Deferral> deferrals_;
+  std::map<std::uint64_t, double> deferred_until_;  // id -> time before which it does not break
   std::size_t fragments_created_ = 0;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
   std::uint64_t freezes_stalled_ = 0;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "drivers/crusher_breakage.h"
+#include "drivers/crusher_whiten.h"
 #include "drivers/experiment.h"
 #include "drivers/experiment_settings.h"
 
@@ -18,6 +19,7 @@ struct CrusherRunSettings final : ExperimentSettings {
   // Sieve apertures of the product's cumulative passing (mass), mm.
   std::vector<double> sieves_mm{2, 4, 5.6, 8, 11.2, 14, 16, 20, 22.4, 25, 28, 31.5};
   BreakageSettings breakage;  // [experiment.breakage]; off without the table
+  WhitenSettings whiten;      // whiten_k1_mm, whiten_k2_mm, whiten_exponent
 };
 
 std::shared_ptr<ExperimentSettings> readCrusherRunSettings(TableReader& table, const SettingsContext& context);

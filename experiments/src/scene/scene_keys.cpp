@@ -279,6 +279,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher", "", "", "type = \"crusher\": the cone crusher's run (docs/crusher.md): spheres below discharge_height are product (removed, size and mass in product.csv); ends when the chamber is empty."},
       {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
       {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},
+      {"experiment.crusher", "whiten_k1_mm", "mm", "k1 of Whiten's classification (Eq 3-21 to 3-23), below which nothing is selected for breakage; 0: the built chamber's closed-side gap."},
+      {"experiment.crusher", "whiten_k2_mm", "mm", "k2 of Whiten's classification, above which everything is selected; 0: the built chamber's open-side setting."},
+      {"experiment.crusher", "whiten_exponent", "", "Exponent of Eq 3-22 (the study prints 2; Whiten's fits are often about 2.3)."},
       {"experiment.crusher.breakage", "", "", "[experiment.breakage] of type = \"crusher\": population-balance breakage (experiments.md §g.6, docs/crusher.md); off without the table. A ball of at least min_diameter whose octahedral shear stress exceeds its strength is replaced by fragments, which a freeze eases apart."},
       {"experiment.crusher.breakage", "check_interval", "s", "Time between breakage checks; 0 = automatic: a quarter of the contact time pi sqrt(m/k) of a ball of min_diameter on a wall, so every impact is seen near its peak (results.json: crusher.breakage.check_interval_s)."},
       {"experiment.crusher.breakage", "q_ref", "Pa", "q0 at d_ref: the octahedral shear strength 37 % of the balls of that size exceed (Weibull scale)."},
@@ -298,7 +301,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "freeze_stall_tolerance", "", "The freeze also ends (\"stalled\") when the kinetic criterion holds and the largest fragment overlap has not fallen below (1 - this) of its value freeze_stall_window ago: fragments pinched between the held walls or heavy neighbours, whose overlap cannot reach freeze_overlap_fraction."},
       {"experiment.crusher.breakage", "freeze_stall_window", "", "The window of the stall rule in the heaviest fragment's time scale sqrt(m/k) at the freeze density and stiffness (not in cycles: the freeze's step is set by the unbroken balls); 0 = no stall rule (only the overlap criterion ends a freeze)."},
       {"experiment.crusher.breakage", "freeze_stall_max_overlap", "", "The stall rule ends a freeze only when the largest fragment overlap is at most this fraction of the smaller radius (higher plateaus are squeezes the fragments leave later; handed back at rock stiffness they would fire the fragments apart)."},
-      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles stops the run (with the criteria's values)."},
+      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles is crowded: its fragments found no room (freeze_defer_crowded says what follows)."},
+      {"experiment.crusher.breakage", "freeze_defer_crowded", "", "After a crowded freeze: true keeps its parents whole for defer_time (results.json breakage.deferred); false stops the run with the criteria's values."},
+      {"experiment.crusher.breakage", "defer_time", "s", "How long a ball whose fragments found no room stays whole before it may break again."},
       {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
@@ -582,6 +587,8 @@ freeze_stall_window = 2
 freeze_stall_max_overlap = 0.01
 freeze_max_cycles = 1000000
 freeze_check_cycles = 20
+freeze_defer_crowded = true
+defer_time = 2e-3
 )",
 };
 

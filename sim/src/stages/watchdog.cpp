@@ -115,6 +115,7 @@ void World::Impl::checkEnergy(const Energy& e) {
     guard.energy_scale = std::abs(e.kinetic_translational + e.kinetic_rotational + e.elastic) +
                    mass * gravity.norm() * extent;
     guard.energy_ref_valid = guard.energy_scale > 0;
+    for (const double w : guard.wall_work) guard.wall_work_carried += w;  // World::movingWallWork keeps it
     std::fill(guard.wall_work.begin(), guard.wall_work.end(), 0.0);
     std::fill(guard.wall_work_gross.begin(), guard.wall_work_gross.end(), 0.0);
     return;

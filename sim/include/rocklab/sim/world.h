@@ -74,6 +74,10 @@ struct WorldState {
   std::vector<PairHistory> pair_history;
   std::vector<WallHistory> wall_history;
   BondState bonds;  // every bond, intact and broken; empty without bonds
+  // J, World::movingWallWork() when exported: a World built from the state goes on
+  // counting from it (an experiment that rebuilds its World keeps the total). Not
+  // in checkpoints: a restart counts from 0.
+  double moving_wall_work = 0.0;
 };
 
 /// The stages of one step, in their order (see the head of this file).
@@ -148,6 +152,11 @@ class World {
   /// elastic contact forces of the last step (no dashpots: with contact damping
   /// the dashpots' share is left out). A platen's load cell.
   std::vector<Vec3> wallForces() const;
+  /// Work (J) the moving walls have done on the balls (WorldState::moving_wall_work
+  /// says since when): every step, each wall contact's force, dashpots included,
+  /// times the wall's velocity at the contact; summed in ball order, so the same on
+  /// any number of threads. 0 without a moving wall. A crusher's mantle energy.
+  double movingWallWork() const;
 
   /// Adds forces other than contacts (force_contribution.h); called in the
   /// `extra forces` stage in the order added. A world with contributions no
