@@ -177,6 +177,27 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
   CHECK(c["power_W"] == c["power"]["power_W"]);
   CHECK(c["breakages"] == 0);
   CHECK(fs::exists(out / "mantle_power.png"));
+  // `rocklab whiten` on the run: k1 above every ball selects none (the product is
+  // the feed); k1, k2 across the feed's 8-9 mm break some, mass kept; bad values and
+  // a folder without a crusher run are bad input.
+  const fs::path whiten = test::scratchDir("crusher-run-whiten");
+  REQUIRE(test::cli({"whiten", out.string(), "--k1-mm", "30", "--k2-mm", "40", "--out", whiten.string()}) == 0);
+  {
+    std::ifstream w_in(whiten / "whiten.json");
+    const auto w = nlohmann::json::parse(w_in);
+    CHECK(w["passing"] == c["feed_psd"]);
+  }
+  REQUIRE(test::cli({"whiten", out.string(), "--k1-mm", "4", "--k2-mm", "8.5", "--out", whiten.string()}) == 0);
+  {
+    std::ifstream w_in(whiten / "whiten.json");
+    const auto w = nlohmann::json::parse(w_in);
+    CHECK(w["passing"][3]["passing"].get<double>() > 0);  // finer than 8 mm now: broken pieces
+    CHECK(std::abs(w["mass_balance_relative"].get<double>()) < 1e-14);
+  }
+  CHECK(fs::exists(whiten / "whiten.png"));
+  CHECK(test::cli({"whiten", out.string(), "--k1-mm", "9", "--k2-mm", "8"}) == 2);
+  CHECK(test::cli({"whiten", whiten.string()}) == 2);  // no results.json there
+  fs::remove_all(whiten);
   CHECK(fs::exists(out / "vtk/walls.pvd"));
   CHECK(fs::exists(out / "vtk/walls_000001.vtp"));
   fs::remove_all(out);

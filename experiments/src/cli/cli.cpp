@@ -16,6 +16,7 @@
 #include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
 #include "crusher/crusher_geometry_command.h"
+#include "crusher/whiten_command.h"
 #include "report/run_report.h"
 #include "camera/render_run.h"
 #include "common/json_text.h"
@@ -56,6 +57,7 @@ Examples:
   rocklab calibrate-bonds zwick-dense --fraction 40-60 --count 30 --jobs 2   # bond strength for Table 5.1
   rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
   rocklab crusher-geometry cone-crusher --set crusher.css=0.012   # chamber quantities + section.png
+  rocklab whiten out/crusher --k1-mm 12 --k2-mm 25   # Whiten's model on a crusher run's feed
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -172,6 +174,8 @@ struct CliArgs {
   std::string fraction;
   double sigma0_mpa = 0, modulus = 0, trial_strength = 60e6;
   int count = 30, trials = 3, trial_orientations = 1;
+  // whiten
+  WhitenCommandOptions whiten;
 };
 
 /// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
@@ -258,6 +262,14 @@ void addCommands(CLI::App& app, CliArgs& a) {
   crusher->add_option("scene", a.scene_arg, "Scene TOML file or built-in name with a [crusher] table")->required();
   crusher->add_option("--set", a.overrides, "Override a scene key, e.g. --set crusher.css=0.012")->take_all();
   crusher->add_option("--out", a.out_dir, "Output directory for section.png and results.json (default: out/<scene name>-geometry)");
+  auto* whiten = app.add_subcommand(
+      "whiten", "Whiten's classification-breakage model (Eq 3-20) on a crusher run's feed, beside its DEM product");
+  whiten->add_option("run", a.collect_dir, "Folder of a finished crusher run (its results.json)")->required();
+  whiten->add_option("--k1-mm", a.whiten.k1_mm, "k1 of Eq 3-21..3-23, mm (default: the run's, its chamber's closed-side gap)");
+  whiten->add_option("--k2-mm", a.whiten.k2_mm, "k2, mm (default: the run's, its chamber's open-side setting)");
+  whiten->add_option("--exponent", a.whiten.exponent, "Exponent of Eq 3-22 (default 2, as the study prints it)");
+  whiten->add_option("--mode", a.whiten.mode, "Breakage split: triple (60/30/10 %) or equal (default: the run's)");
+  whiten->add_option("--out", a.out_dir, "Folder for whiten.json and whiten.png (default: the run's folder)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -523,6 +535,11 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
   if (app.got_subcommand("crusher-geometry"))
     return runCrusherGeometry({a.scene_arg, a.overrides, a.out_dir}, std::cout, std::cerr);
   if (app.got_subcommand("scene-keys")) return doSceneKeys(a.collect_dir);
+  if (app.got_subcommand("whiten")) {
+    a.whiten.run_dir = a.collect_dir;
+    a.whiten.out_dir = a.out_dir;
+    return runWhitenCommand(a.whiten, std::cout, std::cerr);
+  }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);
   if (app.got_subcommand("weibull")) {

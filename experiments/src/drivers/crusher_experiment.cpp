@@ -107,8 +107,12 @@ class CrusherRunExperiment final : public Experiment {
   void report(nlohmann::json& r, const std::filesystem::path& out_dir, std::ostream& log) override {
     const double product_mass = massOf(product_), feed_mass = massOf(feed_);
     const std::vector<double> product_passing = passingOf(product_), feed_passing = passingOf(feed_);
-    WhitenInputs whiten{e_.sieves_mm, &feed_, &product_, e_.breakage.enabled ? &breakage_.events() : nullptr,
-                        e_.breakage.mode};
+    WhitenInputs whiten;
+    whiten.sieves_mm = e_.sieves_mm;
+    whiten.feed = &feed_;
+    whiten.product = &product_;
+    whiten.events = e_.breakage.enabled ? &breakage_.events() : nullptr;
+    whiten.mode = e_.breakage.mode;
     if (chamber_) {
       whiten.chamber_css = chamber_->closed_side_gap;
       whiten.chamber_oss = chamber_->open_side_setting;

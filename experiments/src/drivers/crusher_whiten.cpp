@@ -26,12 +26,31 @@ Eigen::VectorXd massPerClass(const SizeClasses& classes, const std::vector<crush
   return m;
 }
 
+std::vector<double> metres(const std::vector<double>& sieves_mm) {
+  std::vector<double> sieves;
+  for (const double s : sieves_mm) sieves.push_back(s * 1e-3);
+  return sieves;
+}
+
 }  // namespace
 
+WhitenPrediction whitenFromParameters(const std::vector<double>& sieves_mm, const Eigen::VectorXd& feed, double k1,
+                                      double k2, double exponent, crusher::SplitMode mode) {
+  const SizeClasses classes(metres(sieves_mm));
+  const Eigen::Index n = static_cast<Eigen::Index>(classes.size());
+  Eigen::VectorXd c(n);
+  for (Eigen::Index k = 0; k < n; ++k)
+    c[k] = crusher::whitenClassification(classes.representative(static_cast<std::size_t>(k)), k1, k2, exponent);
+  std::vector<double> ratio, fractions = crusher::massFractions(mode);
+  for (const double f : fractions) ratio.push_back(std::cbrt(f));
+  const Eigen::VectorXd product =
+      crusher::whitenProduct(crusher::splitBreakageMatrix(classes, ratio, fractions), c, feed);
+  return {toVector(c), crusher::passingOfClasses(classes, product),
+          feed.sum() > 0 ? (product.sum() - feed.sum()) / feed.sum() : 0.0};
+}
+
 nlohmann::json whitenReport(const WhitenSettings& settings, const WhitenInputs& in, std::vector<double>& model_passing) {
-  std::vector<double> sieves;
-  for (const double s : in.sieves_mm) sieves.push_back(s * 1e-3);
-  const SizeClasses classes(sieves);
+  const SizeClasses classes(metres(in.sieves_mm));
   const Eigen::Index n = static_cast<Eigen::Index>(classes.size());
   const Eigen::VectorXd feed = massPerClass(classes, *in.feed);
   nlohmann::json r;
@@ -47,21 +66,15 @@ nlohmann::json whitenReport(const WhitenSettings& settings, const WhitenInputs& 
   nlohmann::json p;
   model_passing.clear();
   if (k1 > 0 && k2 > k1) {
-    Eigen::VectorXd c(n);
-    for (Eigen::Index k = 0; k < n; ++k)
-      c[k] = crusher::whitenClassification(classes.representative(static_cast<std::size_t>(k)), k1, k2, settings.exponent);
-    std::vector<double> ratio, fractions = crusher::massFractions(in.mode);
-    for (const double f : fractions) ratio.push_back(std::cbrt(f));
-    const Eigen::MatrixXd B = crusher::splitBreakageMatrix(classes, ratio, fractions);
-    const Eigen::VectorXd product = crusher::whitenProduct(B, c, feed);
-    model_passing = crusher::passingOfClasses(classes, product);
+    const WhitenPrediction w = whitenFromParameters(in.sieves_mm, feed, k1, k2, settings.exponent, in.mode);
+    model_passing = w.passing;
     p = {{"k1_mm", k1 * 1e3},
          {"k2_mm", k2 * 1e3},
          {"exponent", settings.exponent},
          {"split", crusher::modeName(in.mode)},
-         {"selection", toVector(c)},
+         {"selection", w.selection},
          {"passing", passingJson(in.sieves_mm, model_passing)},
-         {"mass_balance_relative", feed.sum() > 0 ? (product.sum() - feed.sum()) / feed.sum() : 0.0}};
+         {"mass_balance_relative", w.mass_balance_relative}};
   } else {
     p = {{"skipped", "needs 0 < k1 < k2: set experiment.whiten_k1_mm and whiten_k2_mm, or run a scene with a [crusher]"}};
   }

@@ -15,6 +15,7 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include "crusher/product_statistics.h"
@@ -35,6 +36,16 @@ struct WhitenInputs {
   crusher::SplitMode mode = crusher::SplitMode::Triple;
   std::optional<double> chamber_css, chamber_oss;  // m, of the built chamber when the scene has one
 };
+
+/// Whiten's model from parameters for a feed given as mass per size class of
+/// `sieves_mm` (crusher::SizeClasses, coarse to fine): k1, k2 in m, B from `mode`.
+struct WhitenPrediction {
+  std::vector<double> selection;  // c per class
+  std::vector<double> passing;    // the product's mass fraction finer than each sieve
+  double mass_balance_relative = 0;
+};
+WhitenPrediction whitenFromParameters(const std::vector<double>& sieves_mm, const Eigen::VectorXd& feed_per_class,
+                                      double k1, double k2, double exponent, crusher::SplitMode mode);
 
 /// results.json's crusher.whiten; `model_passing` gets the from-parameters curve
 /// (mass fraction finer than each sieve; empty when k1, k2 are unknown).
