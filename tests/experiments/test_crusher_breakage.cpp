@@ -295,69 +295,157 @@ FreezeCase fragmentRow(double start, std::optional<double> keep) {
 TEST_CASE("a freeze whose fragments are pinched between held walls ends as stalled with the overlap they keep, and free "
           "fragments still converge",
           "[crusher]") {
-  const crusher::FreezeSettings settings;  // the defaults
+  for (const crusher::FreezeScope scope :
+       {crusher::FreezeScope::Local, crusher::FreezeScope::All}) {
+    INFO("scope " << crusher::freezeScopeName(scope));
+    crusher::FreezeSettings settings;  // the defaults
+    settings.scope = scope;
+    const std::vector<std::uint32_t> fragments{0, 1};
+    // Snug: 0.1 mm (0.02 of the radius) at the split, 25 um (0.005) kept, within
+    // freeze_stall_max_overlap. (Parting from a deeper overlap the pair swings past
+    // its rest and is apart for a moment, which ends the freeze as converged.)
+    FreezeCase pinched = fragmentRow(1e-4, 25e-6);
+    const crusher::FreezeResult stalled =
+        crusher::freezeFragments(pinched.model, pinched.state, fragments, settings, 1);
+    INFO("pinched: " << stalled.cycles << " cycles of " << stalled.dt << " s, window "
+                     << stalled.stall_window_cycles << " cycles, overlap " << stalled.max_overlap
+                     << ", kinetic " << stalled.kinetic_energy << " of "
+                     << stalled.artificial_energy << " J");
+    CHECK(stalled.end == crusher::FreezeEnd::Stalled);
+    CHECK(std::string(crusher::freezeEndName(stalled.end)) == "stalled");
+    // What the walls allow (0.005), nearly: the last approach to rest under local
+    // damping is a creep (the damped force is 0.1 of a spring force that vanishes at
+    // rest) slower than 1 % per window, so the rule ends it a little above.
+    CHECK(stalled.max_overlap >= 0.005 * 0.999);
+    CHECK(stalled.max_overlap < 0.005 * 1.25);
+    CHECK(stalled.kinetic_energy <= settings.kinetic_fraction * stalled.artificial_energy);
+    // The window is the fragments' time: with every ball in, thousands of the rock
+    // ball's steps, not a handful of cycles.
+    if (scope == crusher::FreezeScope::All) CHECK(stalled.stall_window_cycles > 1000);
+    CHECK(stalled.cycles < 6 * stalled.stall_window_cycles);  // a few windows, not the cap
+    CHECK(stalled.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 20);
+    const sim::ParticleState& p = pinched.state.particles;
+    CHECK(2 * p.radius[0] - (p.position[1] - p.position[0]).norm() ==
+          Approx(stalled.max_overlap * 0.005));  // kept
+
+    // The same row without the walls: the pair pushes itself and the ball apart and
+    // meets the overlap criterion (the stall rule must not end it while the fragments
+    // are still getting under way).
+    FreezeCase free = fragmentRow(2e-3, std::nullopt);
+    const crusher::FreezeResult converged =
+        crusher::freezeFragments(free.model, free.state, fragments, settings, 1);
+    INFO("free: " << converged.cycles << " cycles, overlap " << converged.max_overlap);
+    CHECK(converged.end == crusher::FreezeEnd::Converged);
+    CHECK(converged.max_overlap <= settings.overlap_fraction);
+
+    // Tight: 2 mm (0.4) at the split, 1.25 mm (0.25) kept, above
+    // freeze_stall_max_overlap: no stall, the freeze runs into freeze_max_cycles;
+    // with the bound raised it stalls there.
+    crusher::FreezeSettings capped = settings;
+    capped.max_cycles = static_cast<std::int64_t>(4 * stalled.cycles);
+    FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
+    // By default such a freeze is crowded: it ends so, the state as it was.
+    const std::vector<Vec3> tight_start = tight.state.particles.position;
+    const crusher::FreezeResult crowded =
+        crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
+    CHECK(crowded.end == crusher::FreezeEnd::Crowded);
+    CHECK(crowded.cycles == static_cast<std::uint64_t>(capped.max_cycles));
+    CHECK(tight.state.particles.position == tight_start);
+    capped.defer_crowded = false;  // or the run stops, naming the settings
+    CHECK_THROWS_WITH(crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1),
+                      Contains("freeze_max_cycles") && Contains("freeze_stall_max_overlap = 0.01"));
+    capped.stall_max_overlap = 0.3;
+    tight = fragmentRow(2e-3, 1.25e-3);
+    const crusher::FreezeResult deep =
+        crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
+    CHECK(deep.end == crusher::FreezeEnd::Stalled);
+    CHECK(deep.max_overlap > 0.2);
+    // At about the rest overlap: with every ball in, within 0.1 %; in the local
+    // freeze, whose step is a quarter of the fragments' time scale, the creep under
+    // local damping is slower per window and the rule ends it a few % above.
+    CHECK(deep.max_overlap <= 0.25 * 1.1);
+
+    // Without the stall rule the snug row runs into freeze_max_cycles, as before.
+    crusher::FreezeSettings no_stall = settings;
+    no_stall.stall_window = 0;
+    no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
+    no_stall.defer_crowded = false;
+    FreezeCase again = fragmentRow(1e-4, 25e-6);
+    CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
+                      Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
+  }
+}
+
+TEST_CASE(
+    "a local freeze holds the balls near the fragments still, leaves the others out, steps at the "
+    "fragments' own "
+    "pace, and widens its reach when a fragment travels beyond it",
+    "[crusher]") {
   const std::vector<std::uint32_t> fragments{0, 1};
-  // Snug: 0.1 mm (0.02 of the radius) at the split, 25 um (0.005) kept, within
-  // freeze_stall_max_overlap. (Parting from a deeper overlap the pair swings past
-  // its rest and is apart for a moment, which ends the freeze as converged.)
-  FreezeCase pinched = fragmentRow(1e-4, 25e-6);
-  const crusher::FreezeResult stalled = crusher::freezeFragments(pinched.model, pinched.state, fragments, settings, 1);
-  INFO("pinched: " << stalled.cycles << " cycles of " << stalled.dt << " s, window " << stalled.stall_window_cycles
-                   << " cycles, overlap " << stalled.max_overlap << ", kinetic " << stalled.kinetic_energy << " of "
-                   << stalled.artificial_energy << " J");
-  CHECK(stalled.end == crusher::FreezeEnd::Stalled);
-  CHECK(std::string(crusher::freezeEndName(stalled.end)) == "stalled");
-  // What the walls allow (0.005), nearly: the last approach to rest under local
-  // damping is a creep (the damped force is 0.1 of a spring force that vanishes at
-  // rest) slower than 1 % per window, so the rule ends it a little above.
-  CHECK(stalled.max_overlap >= 0.005 * 0.999);
-  CHECK(stalled.max_overlap < 0.005 * 1.25);
-  CHECK(stalled.kinetic_energy <= settings.kinetic_fraction * stalled.artificial_energy);
-  CHECK(stalled.stall_window_cycles > 1000);  // the window is the fragments' time, not a handful of cycles
-  CHECK(stalled.cycles < 6 * stalled.stall_window_cycles);  // a few windows, not the cap
-  CHECK(stalled.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 20);
-  const sim::ParticleState& p = pinched.state.particles;
-  CHECK(2 * p.radius[0] - (p.position[1] - p.position[0]).norm() == Approx(stalled.max_overlap * 0.005));  // kept
+  crusher::FreezeSettings all;
+  all.scope = crusher::FreezeScope::All;
+  const crusher::FreezeSettings local;  // the default
+  REQUIRE(local.scope == crusher::FreezeScope::Local);
+  FreezeCase a = fragmentRow(2e-3, std::nullopt), l = fragmentRow(2e-3, std::nullopt);
+  const crusher::FreezeResult ra = crusher::freezeFragments(a.model, a.state, fragments, all, 1);
+  const crusher::FreezeResult rl = crusher::freezeFragments(l.model, l.state, fragments, local, 1);
+  INFO("all: " << ra.cycles << " cycles of " << ra.dt << " s; local: " << rl.cycles << " cycles of "
+               << rl.dt << " s");
+  CHECK(ra.end == crusher::FreezeEnd::Converged);
+  CHECK(rl.end == crusher::FreezeEnd::Converged);
+  CHECK(ra.balls == 3);
+  CHECK(rl.balls == 3);  // the rock ball touches a fragment: within the reach
+  // Held, the rock ball has not moved by a bit; with every ball in it was pushed.
+  const Vec3 rock_start = fragmentRow(2e-3, std::nullopt).state.particles.position[2];
+  CHECK(l.state.particles.position[2] == rock_start);
+  CHECK(a.state.particles.position[2] != rock_start);
+  // The step is no longer the rock ball's at the huge density but the fragments'
+  // (k 1e3 against 1e9 N/m at equal masses: sqrt(1e6) = 1000 times longer).
+  CHECK(rl.dt > 100 * ra.dt);
+  CHECK(rl.cycles * 50 < ra.cycles);
+  // The fragments parted in both (overlap criterion met).
+  for (const FreezeCase* c : {&a, &l}) {
+    const sim::ParticleState& p = c->state.particles;
+    CHECK(2 * p.radius[0] - (p.position[1] - p.position[0]).norm() <=
+          local.overlap_fraction * p.radius[0]);
+  }
 
-  // The same row without the walls: the pair pushes itself and the ball apart and
-  // meets the overlap criterion (the stall rule must not end it while the fragments
-  // are still getting under way).
-  FreezeCase free = fragmentRow(2e-3, std::nullopt);
-  const crusher::FreezeResult converged = crusher::freezeFragments(free.model, free.state, fragments, settings, 1);
-  INFO("free: " << converged.cycles << " cycles, overlap " << converged.max_overlap);
-  CHECK(converged.end == crusher::FreezeEnd::Converged);
-  CHECK(converged.max_overlap <= settings.overlap_fraction);
-
-  // Tight: 2 mm (0.4) at the split, 1.25 mm (0.25) kept, above
-  // freeze_stall_max_overlap: no stall, the freeze runs into freeze_max_cycles;
-  // with the bound raised it stalls there.
-  crusher::FreezeSettings capped = settings;
-  capped.max_cycles = static_cast<std::int64_t>(4 * stalled.cycles);
-  FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
-  // By default such a freeze is crowded: it ends so, the state as it was.
-  const std::vector<Vec3> tight_start = tight.state.particles.position;
-  const crusher::FreezeResult crowded = crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
-  CHECK(crowded.end == crusher::FreezeEnd::Crowded);
-  CHECK(crowded.cycles == static_cast<std::uint64_t>(capped.max_cycles));
-  CHECK(tight.state.particles.position == tight_start);
-  capped.defer_crowded = false;  // or the run stops, naming the settings
-  CHECK_THROWS_WITH(crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1),
-                    Contains("freeze_max_cycles") && Contains("freeze_stall_max_overlap = 0.01"));
-  capped.stall_max_overlap = 0.3;
-  tight = fragmentRow(2e-3, 1.25e-3);
-  const crusher::FreezeResult deep = crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
-  CHECK(deep.end == crusher::FreezeEnd::Stalled);
-  CHECK(deep.max_overlap > 0.2);
-  CHECK(deep.max_overlap <= 0.25 * 1.001);
-
-  // Without the stall rule the snug row runs into freeze_max_cycles, as before.
-  crusher::FreezeSettings no_stall = settings;
-  no_stall.stall_window = 0;
-  no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
-  no_stall.defer_crowded = false;
-  FreezeCase again = fragmentRow(1e-4, 25e-6);
-  CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
-                    Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
+  // A ball to the left of fragment 0, 0.5 mm from it: the fragment travels ~1 mm
+  // left. With a reach of 0.01 diameters (0.1 mm) the ball is out of the first
+  // freeze, which the fragment ends inside it: the reach doubles to 0.2, 0.4 and
+  // 0.8 mm, which takes it in. With the default reach (10 mm) it is in at once, and
+  // 50 mm away it is never in.
+  const auto withBallLeft = [](double gap) {
+    FreezeCase c = fragmentRow(2e-3, std::nullopt);
+    sim::ParticleState& p = c.state.particles;
+    p.position[2] =
+        p.position[0] - Vec3(2 * p.radius[0] + gap, 0, 0);  // the rock ball moved to the left
+    return c;
+  };
+  crusher::FreezeSettings short_reach = local;
+  short_reach.local_reach = 0.01;
+  FreezeCase near = withBallLeft(0.5e-3);
+  const crusher::FreezeResult widened =
+      crusher::freezeFragments(near.model, near.state, fragments, short_reach, 1);
+  INFO("widened: " << widened.reach_widenings << " widenings, " << widened.balls << " balls, "
+                   << widened.cycles << " cycles, end " << crusher::freezeEndName(widened.end));
+  CHECK(widened.reach_widenings == 3);
+  CHECK(widened.balls == 3);
+  CHECK(widened.end == crusher::FreezeEnd::Converged);
+  const sim::ParticleState& pn = near.state.particles;
+  CHECK((pn.position[0] - pn.position[2]).norm() >=
+        2 * pn.radius[0] * (1 - local.overlap_fraction));  // not inside it
+  FreezeCase in_reach = withBallLeft(0.5e-3);
+  const crusher::FreezeResult at_once =
+      crusher::freezeFragments(in_reach.model, in_reach.state, fragments, local, 1);
+  CHECK(at_once.reach_widenings == 0);
+  CHECK(at_once.balls == 3);
+  FreezeCase far = withBallLeft(50e-3);
+  const crusher::FreezeResult alone =
+      crusher::freezeFragments(far.model, far.state, fragments, local, 1);
+  CHECK(alone.reach_widenings == 0);
+  CHECK(alone.balls == 2);
+  CHECK(alone.end == crusher::FreezeEnd::Converged);
 }
 
 TEST_CASE("a stop request during a freeze ends it at once and leaves the state as it was before the breakage",
@@ -402,6 +490,16 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
              Contains("experiment.breakage.freeze_stall_tolerance") && Contains("[0, 1)"));
   CHECK_THAT(error("experiment.breakage.freeze_stall_window=-1"), Contains("experiment.breakage.freeze_stall_window"));
   CHECK_THAT(error("experiment.breakage.q_reff=1"), Contains("q_reff"));
+  CHECK_THAT(error("experiment.breakage.freeze_scope=\"near\""),
+             Contains("experiment.breakage.freeze_scope") && Contains("\"local\""));
+  CHECK_THAT(error("experiment.breakage.freeze_local_reach=0"),
+             Contains("experiment.breakage.freeze_local_reach"));
+  CHECK_THAT(error("experiment.breakage.freeze_held_density=-1"),
+             Contains("experiment.breakage.freeze_held_density"));
+  CHECK(
+      settingsOf<CrusherRunSettings>(loadScene(scene, {"experiment.breakage.freeze_scope=\"all\""}))
+          .breakage.freeze.scope == crusher::FreezeScope::All);
+  CHECK(b.freeze.scope == crusher::FreezeScope::Local);
 
   // The tiny run's step (soft contacts) is too long for a 1.9 mm fragment at 70 GPa.
   const fs::path out = test::scratchDir("crusher-breakage-dt");
@@ -467,6 +565,8 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
           Approx(balance["product_kg"].get<double>() + balance["in_chamber_kg"].get<double>()).epsilon(1e-14));
     CHECK(b["freezes_converged"].get<int>() + b["freezes_stalled"].get<int>() == b["freezes"].get<int>());
     CHECK(b["max_freeze_overlap_fraction"].get<double>() >= 0);
+    CHECK(b["freeze_scope"] == "local");
+    CHECK(b["max_freeze_balls"].get<int>() >= 3);  // at least the three fragments
     const std::string events = test::slurp(out / "breakage.csv");
     CHECK(std::count(events.begin(), events.end(), '\n') == 1 + b["events"].get<int>());
     CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction\n"));

@@ -64,9 +64,10 @@ sim::Model freezeModel(const sim::Model& run, double t, std::vector<std::int32_t
   return m;
 }
 
-double kineticEnergy(const sim::ParticleState& p) {
+/// Kinetic energy of the balls `rows` (J).
+double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_t>& rows) {
   double e = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
+  for (const std::uint32_t i : rows)
     e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() + 0.5 * p.omega[i].squaredNorm() / p.inv_inertia[i];
   return e;
 }
@@ -126,16 +127,28 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
   return o;
 }
 
-FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
-                             const std::vector<std::uint32_t>& fragments, const FreezeSettings& s, int threads) {
-  sim::WorldState frozen = state;
+namespace {
+
+/// One freeze of `frozen` (a copy of the run's balls, or of the local ones): the
+/// fragments at `density`, the balls flagged in `held` at held_density, all at
+/// rest, cycled until a way out. `after` receives the state at the end when the
+/// freeze converged or stalled.
+FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
+                       const std::vector<std::uint32_t>& fragments, const std::vector<bool>& held,
+                       const FreezeSettings& s, int threads, double t_break,
+                       sim::WorldState& after) {
   sim::ParticleState& p = frozen.particles;
-  const sim::Model m = freezeModel(model, state.time, p.material, fragments, s);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    sim::setFreeSphereMass(p, i, sim::sphereMass(s.density, p.radius[i]));
+  const sim::Model m = freezeModel(model, frozen.time, p.material, fragments, s);
+  std::vector<std::uint32_t> moving;  // the balls whose kinetic energy counts
+  for (std::uint32_t i = 0; i < p.size(); ++i) {
+    const bool is_held = !held.empty() && held[i];
+    sim::setFreeSphereMass(p, i,
+                           sim::sphereMass(is_held ? s.held_density : s.density, p.radius[i]));
     p.velocity[i] = p.omega[i] = Vec3::Zero();
+    if (!is_held) moving.push_back(i);
   }
   FreezeResult result;
+  result.balls = p.size();
   result.dt = sim::auditTimestep(m, p).automatic;
   frozen.time = 0.0;  // the freeze's own clock (time = step x dt)
   frozen.step = 0;
@@ -148,15 +161,20 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
   if (s.stall_window > 0)
     result.stall_window_cycles =
         std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(s.stall_window * std::sqrt(heaviest / s.stiffness) / result.dt)));
+  // At the fragments' own step ("local") the window is a few hundred cycles: the
+  // criteria are looked at often enough to see it.
+  std::uint64_t check = static_cast<std::uint64_t>(s.check_cycles);
+  if (result.stall_window_cycles > 0)
+    check = std::clamp<std::uint64_t>(result.stall_window_cycles / 4, 1, check);
   OverlapStall stall(result.stall_window_cycles, s.stall_tolerance);
   for (;;) {
-    if (result.cycles % static_cast<std::uint64_t>(s.check_cycles) == 0) {
+    if (result.cycles % check == 0) {
       if (stopRequested()) {
         result.end = FreezeEnd::Interrupted;
-        return result;  // `state` untouched
+        return result;
       }
       result.max_overlap = fragmentOverlaps(m, world.particles(), fragments).max_fraction;
-      result.kinetic_energy = kineticEnergy(world.particles());
+      result.kinetic_energy = kineticEnergy(world.particles(), moving);
       const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;
       const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample
       // The overlap criterion first: a freeze that can converge ends as converged.
@@ -168,18 +186,21 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
       if (result.cycles >= static_cast<std::uint64_t>(s.max_cycles)) {
         if (s.defer_crowded) {
           result.end = FreezeEnd::Crowded;
-          return result;  // `state` untouched: the caller keeps the parents
+          return result;
         }
         std::ostringstream msg;
-        msg << "experiment.breakage: the freeze after breakage at t = " << state.time << " s did not end within "
+        msg << "experiment.breakage: the freeze after breakage at t = " << t_break
+            << " s did not end within "
             << "freeze_max_cycles = " << s.max_cycles << " cycles: the largest fragment overlap is "
-            << result.max_overlap << " of the smaller radius (freeze_overlap_fraction = " << s.overlap_fraction
+            << result.max_overlap
+            << " of the smaller radius (freeze_overlap_fraction = " << s.overlap_fraction
             << ") and the kinetic energy " << result.kinetic_energy << " J is "
             << result.kinetic_energy / result.artificial_energy << " of the fragments' initial "
             << result.artificial_energy << " J (freeze_kinetic_fraction = " << s.kinetic_fraction
             << ") and it has not stalled (freeze_stall_tolerance = " << s.stall_tolerance
             << " over freeze_stall_window = " << s.stall_window << " fragment time scales, "
-            << result.stall_window_cycles << " cycles, at an overlap of at most freeze_stall_max_overlap = "
+            << result.stall_window_cycles
+            << " cycles, at an overlap of at most freeze_stall_max_overlap = "
             << s.stall_max_overlap
             << "); raise freeze_max_cycles, relax the criteria, or set freeze_defer_crowded = true";
         throw std::runtime_error(msg.str());
@@ -188,11 +209,114 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     world.step();
     ++result.cycles;
   }
-  const sim::WorldState after = world.exportState();
-  state.particles.position = after.particles.position;
-  state.pair_history = after.pair_history;
-  state.wall_history = after.wall_history;
+  after = world.exportState();
   return result;
+}
+
+/// The balls within `reach` (m, surface to surface) of any of `fragments`, these included.
+std::vector<bool> localBalls(const sim::ParticleState& p,
+                             const std::vector<std::uint32_t>& fragments, double reach) {
+  std::vector<bool> local(p.size(), false);
+  for (const std::uint32_t f : fragments) local[f] = true;
+  for (std::uint32_t j = 0; j < p.size(); ++j)
+    for (const std::uint32_t f : fragments)
+      if (!local[j] && (p.position[j] - p.position[f]).norm() - p.radius[j] - p.radius[f] <= reach)
+        local[j] = true;
+  return local;
+}
+
+/// Whether a fragment (position in `moved`) overlaps a ball not flagged in `local`.
+bool touchesOutside(const sim::ParticleState& p, const std::vector<std::uint32_t>& fragments,
+                    const std::vector<Vec3>& moved, const std::vector<bool>& local) {
+  for (std::size_t k = 0; k < fragments.size(); ++k)
+    for (std::uint32_t j = 0; j < p.size(); ++j)
+      if (!local[j] && (p.position[j] - moved[k]).norm() < p.radius[j] + p.radius[fragments[k]])
+        return true;
+  return false;
+}
+
+}  // namespace
+
+const char* freezeScopeName(FreezeScope scope) {
+  return scope == FreezeScope::All ? "all" : "local";
+}
+
+FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
+                             const std::vector<std::uint32_t>& fragments, const FreezeSettings& s,
+                             int threads) {
+  const sim::ParticleState& p = state.particles;
+  if (s.scope == FreezeScope::All || p.clumps.size() > 0) {  // withoutBalls would take clumps whole
+    sim::WorldState after;
+    const FreezeResult result =
+        runFreeze(model, state, fragments, {}, s, threads, state.time, after);
+    if (result.end == FreezeEnd::Converged || result.end == FreezeEnd::Stalled) {
+      state.particles.position = after.particles.position;
+      state.pair_history = after.pair_history;
+      state.wall_history = after.wall_history;
+    }
+    return result;
+  }
+  double largest = 0;  // m, the largest fragment's diameter
+  for (const std::uint32_t f : fragments) largest = std::max(largest, 2 * p.radius[f]);
+  FreezeResult total;
+  for (double reach = s.local_reach * largest;; reach *= 2) {
+    const std::vector<bool> local = localBalls(p, fragments, reach);
+    std::vector<std::uint32_t>
+        full_row;  // local row -> the run's row (withoutBalls keeps the order)
+    std::vector<std::uint32_t> local_row(p.size(), UINT32_MAX);
+    for (std::uint32_t i = 0; i < p.size(); ++i)
+      if (local[i]) {
+        local_row[i] = static_cast<std::uint32_t>(full_row.size());
+        full_row.push_back(i);
+      }
+    std::vector<bool> outside(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) outside[i] = !local[i];
+    std::vector<std::uint32_t> local_fragments;
+    std::vector<bool> held(full_row.size(), true);
+    for (const std::uint32_t f : fragments) {
+      local_fragments.push_back(local_row[f]);
+      held[local_row[f]] = false;
+    }
+    sim::WorldState after;
+    const FreezeResult result = runFreeze(model, sim::withoutBalls(state, outside), local_fragments,
+                                          held, s, threads, state.time, after);
+    const std::uint64_t cycles = total.cycles + result.cycles;
+    const int widenings = total.reach_widenings;
+    total = result;
+    total.cycles = cycles;
+    total.reach_widenings = widenings;
+    if (result.end != FreezeEnd::Converged && result.end != FreezeEnd::Stalled) return total;
+    std::vector<Vec3> moved;
+    for (const std::uint32_t f : local_fragments) moved.push_back(after.particles.position[f]);
+    if (touchesOutside(p, fragments, moved, local) && full_row.size() < p.size()) {
+      ++total.reach_widenings;  // it travelled beyond the reach: again, wider
+      continue;
+    }
+    std::vector<bool> is_fragment(p.size(), false);
+    for (std::size_t k = 0; k < fragments.size(); ++k) {
+      is_fragment[fragments[k]] = true;
+      state.particles.position[fragments[k]] = moved[k];
+    }
+    // History: the held balls keep theirs, the fragments' comes from the freeze.
+    std::vector<sim::PairHistory> pairs;
+    for (const sim::PairHistory& h : state.pair_history)
+      if (!is_fragment[h.i] && !is_fragment[h.j]) pairs.push_back(h);
+    for (sim::PairHistory h : after.pair_history) {
+      h.i = full_row[h.i];
+      h.j = full_row[h.j];
+      if (is_fragment[h.i] || is_fragment[h.j]) pairs.push_back(h);
+    }
+    std::vector<sim::WallHistory> walls;
+    for (const sim::WallHistory& h : state.wall_history)
+      if (!is_fragment[h.particle]) walls.push_back(h);
+    for (sim::WallHistory h : after.wall_history) {
+      h.particle = full_row[h.particle];
+      if (is_fragment[h.particle]) walls.push_back(h);
+    }
+    state.pair_history = std::move(pairs);
+    state.wall_history = std::move(walls);
+    return total;
+  }
 }
 
 }  // namespace rocklab::experiments::crusher

@@ -54,6 +54,23 @@
 //   - a stop request (rocklab::experiments::stopRequested) is looked at with the
 //     criteria: the freeze ends "interrupted" and leaves `state` as it was.
 //
+// Who takes part (scope):
+//   - "all" (the reference's wording, step 3): every ball of the run, at the huge
+//     density. The freeze's step is then set by the unbroken balls' rock stiffness
+//     at that density, a few hundredths of the fragments' own time scale, so a
+//     freeze costs hundreds of thousands of cycles over every ball of the chamber;
+//   - "local" (the default, our reading of its intent): the fragments and the balls
+//     within local_reach largest-fragment diameters of them (surface to surface).
+//     Those neighbours are held: their density is held_density (1e30: a collision
+//     cannot move them by a round-off), so the step is the fragments' own and the
+//     freeze runs on a few dozen balls. Step 3 gives the unbroken balls a huge
+//     density "so collisions barely move them": held, they do not move at all,
+//     and the balls beyond the reach, which the fragments cannot touch, are left
+//     out. Should a fragment end touching a ball outside the set (it travelled
+//     further than the reach), the reach doubles and the freeze runs again from
+//     the start. Only the fragments' positions and contact history come back; the
+//     held balls keep their own. A state with clumps is frozen whole ("all").
+//
 // Only the positions (and the contact history at them) come back; masses,
 // stiffnesses, damping, gravity, wall motion and velocities are the run's again.
 #include <cstdint>
@@ -63,8 +80,15 @@
 
 namespace rocklab::experiments::crusher {
 
+/// Who takes part in the freeze (see the head of this file).
+enum class FreezeScope { Local, All };
+const char* freezeScopeName(FreezeScope scope);
+
 struct FreezeSettings {
-  double density = 3e9;           // kg/m^3, every ball's during the freeze
+  FreezeScope scope = FreezeScope::Local;
+  double density = 3e9;           // kg/m^3, every ball's during the freeze ("local": the fragments')
+  double held_density = 1e30;     // kg/m^3, the held neighbours' ("local" only)
+  double local_reach = 1.0;       // largest-fragment diameters, surface to surface ("local" only)
   double stiffness = 1e3;         // N/m, the fragments' kn and ks during the freeze
   double local_damping = 0.9;     // alpha
   double overlap_fraction = 1e-4; // largest fragment overlap / smaller radius that ends it
@@ -74,7 +98,7 @@ struct FreezeSettings {
   double stall_max_overlap = 0.01; // a stall ends the freeze only with the largest overlap at most this
   std::int64_t max_cycles = 1000000;
   bool defer_crowded = true;       // at max_cycles: end "crowded" (true) or stop the run
-  std::int64_t check_cycles = 20;  // cycles between looks at the criterion
+  std::int64_t check_cycles = 20;  // cycles between looks at the criterion (at most a quarter of the stall window)
 };
 
 /// How a freeze ended: both criteria met, the kinetic one with the overlap
@@ -86,18 +110,21 @@ const char* freezeEndName(FreezeEnd end);
 
 struct FreezeResult {
   FreezeEnd end = FreezeEnd::Converged;
-  std::uint64_t cycles = 0;
+  std::uint64_t cycles = 0;        // over every run of it ("local": widened reaches included)
   double dt = 0.0;                 // s, the freeze's own step
   std::uint64_t stall_window_cycles = 0;  // the stall rule's window in cycles (0: off)
   double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
   double max_overlap = 0.0;        // largest fragment overlap / smaller radius at the end
-  double kinetic_energy = 0.0;     // J, at the end (freeze masses)
+  double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the fragments')
+  std::size_t balls = 0;           // balls in the freeze World (the last run of it)
+  int reach_widenings = 0;         // "local": runs repeated with the reach doubled
 };
 
 /// Relaxes the balls `fragments` (rows of state.particles) of `state` at time
 /// state.time under `model` (the run's); on return state's positions and contact
-/// history are those after the freeze, everything else as it was. Throws
-/// std::runtime_error (the settings named) when max_cycles pass before either way out.
+/// history are those after the freeze (with scope "local" the fragments' only),
+/// everything else as it was. Throws std::runtime_error (the settings named) when
+/// max_cycles pass before either way out and defer_crowded is off.
 FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
                              const std::vector<std::uint32_t>& fragments, const FreezeSettings& settings,
                              int threads);

@@ -37,6 +37,11 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   s.class_ratio = b->number("class_ratio", s.class_ratio,
                             {1.0, std::numeric_limits<double>::infinity(), true, false});
   crusher::FreezeSettings& f = s.freeze;
+  f.scope = b->string("freeze_scope", crusher::freezeScopeName(f.scope), {"local", "all"}) == "all"
+                ? crusher::FreezeScope::All
+                : crusher::FreezeScope::Local;
+  f.held_density = b->number("freeze_held_density", f.held_density, Range::positive());
+  f.local_reach = b->number("freeze_local_reach", f.local_reach, Range::positive());
   f.density = b->number("freeze_density", f.density, Range::positive());
   f.stiffness = b->number("freeze_stiffness", f.stiffness, Range::positive());
   f.local_damping = b->number("freeze_local_damping", f.local_damping, {0.0, 1.0, false, true});
@@ -91,6 +96,9 @@ void CrusherBreakage::start(const sim::World& world) {
     throw std::invalid_argument(
         "experiment.breakage needs contact.law = \"linear\" (Table 6.2: k = 4 R E_c per size class)");
   const sim::ParticleState& p = world.particles();
+  if (p.clumps.size() > 0)
+    throw std::invalid_argument(
+        "experiment.breakage splits free spheres (§g.6); this scene has clumps, whose member balls it cannot split");
   check_interval_ = s_.check_interval > 0 ? s_.check_interval : automaticCheckInterval(world.model(), p);
   every_ = stepsIn(check_interval_, world.dt());
   for (const std::uint64_t id : p.id) next_id_ = std::max(next_id_, id + 1);
@@ -223,6 +231,8 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   max_freeze_overlap_ = std::max(max_freeze_overlap_, freeze.max_overlap);
   freeze_cycles_ += freeze.cycles;
   max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
+  max_freeze_balls_ = std::max(max_freeze_balls_, freeze.balls);
+  reach_widenings_ += static_cast<std::uint64_t>(freeze.reach_widenings);
   world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
   return true;
 }
@@ -271,6 +281,9 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freezes_converged"] = freezes_ - freezes_stalled_;
   b["freezes_stalled"] = freezes_stalled_;
   b["max_freeze_overlap_fraction"] = max_freeze_overlap_;
+  b["freeze_scope"] = crusher::freezeScopeName(s_.freeze.scope);
+  b["max_freeze_balls"] = max_freeze_balls_;
+  b["freeze_reach_widenings"] = reach_widenings_;
   nlohmann::json deferred = nlohmann::json::array();
   for (const Deferral& d : deferrals_)
     deferred.push_back({{"time_s", d.time}, {"parents", d.parents}, {"freeze_cycles", d.cycles},
@@ -288,7 +301,8 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
                    {"min_diameter_mm", s_.min_diameter * 1e3}};
   b["method"] = "every check_interval a ball of at least min_diameter whose octahedral shear stress q exceeds its "
                 "strength q0(d) (-ln U)^(1/m) (U from the seed and its id) is replaced by fragments inside it along "
-                "its minor principal stress; a freeze (own clock, walls held) eases them apart (breakage.csv)";
+                "its minor principal stress; a freeze (own clock, walls held; scope \"local\": the fragments among "
+                "their held neighbours, \"all\": every ball) eases them apart (breakage.csv)";
   return b;
 }
 

@@ -108,7 +108,9 @@ class CrusherBreakage {
   std::size_t fragments_created_ = 0;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
   std::uint64_t freezes_stalled_ = 0;
-  double max_freeze_overlap_ = 0;  // the largest overlap fraction a freeze left
+  double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left
+  std::size_t max_freeze_balls_ = 0;      // the most balls a freeze World held
+  std::uint64_t reach_widenings_ = 0;     // "local" freezes run again with a wider reach
 };
 
 }  // namespace rocklab::experiments

@@ -293,7 +293,10 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "offsets", "", "Fragment centres along the minor principal stress direction, in parent radii, one per fragment, each fragment inside the parent. Default: triple [-0.157, 0.331, 0] (60 % and 30 % internally tangent at opposite ends, 10 % at the centre), equal [-0.206, 0.206]."},
       {"experiment.crusher.breakage", "youngs_modulus", "Pa", "E_c of the fragments' stiffness k = 4 R E_c (Eq 6-14), R the middle of the fragment's size class."},
       {"experiment.crusher.breakage", "class_ratio", "", "Width of the fragments' size classes (diameters min_diameter x ratio^i to ^(i+1)); each class is a material with its own k."},
-      {"experiment.crusher.breakage", "freeze_density", "kg/m^3", "Every ball's density during the freeze (§g.6 step 3)."},
+      {"experiment.crusher.breakage", "freeze_scope", "", "Who takes part in the freeze: \"local\" the fragments and the balls within freeze_local_reach of them, held still (the freeze's step is the fragments' own, a few dozen balls); \"all\" every ball of the run at freeze_density (§g.6 step 3 as written; the step is set by the unbroken balls' rock stiffness).", "\"local\", \"all\""},
+      {"experiment.crusher.breakage", "freeze_density", "kg/m^3", "Density during the freeze (§g.6 step 3): every ball's (scope \"all\") or the fragments' (\"local\")."},
+      {"experiment.crusher.breakage", "freeze_held_density", "kg/m^3", "Scope \"local\": the density of the held neighbours, so huge that the fragments cannot move them."},
+      {"experiment.crusher.breakage", "freeze_local_reach", "", "Scope \"local\": the neighbours taken in, within this many largest-fragment diameters of a fragment (surface to surface); a fragment that ends touching a ball beyond it doubles the reach and the freeze runs again."},
       {"experiment.crusher.breakage", "freeze_stiffness", "N/m", "The fragments' kn and ks during the freeze (§g.6 step 4)."},
       {"experiment.crusher.breakage", "freeze_local_damping", "", "Local damping alpha during the freeze (§g.6 step 5; viscous damping off)."},
       {"experiment.crusher.breakage", "freeze_overlap_fraction", "", "The freeze may end when no fragment overlaps a ball by more than this fraction of the smaller radius."},
@@ -304,7 +307,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles is crowded: its fragments found no room (freeze_defer_crowded says what follows)."},
       {"experiment.crusher.breakage", "freeze_defer_crowded", "", "After a crowded freeze: true keeps its parents whole for defer_time (results.json breakage.deferred); false stops the run with the criteria's values."},
       {"experiment.crusher.breakage", "defer_time", "s", "How long a ball whose fragments found no room stays whole before it may break again."},
-      {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion."},
+      {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion (at most a quarter of the stall window)."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
       {"experiment.zwick", "top_platen", "", "Plane wall that closes on the specimen.", "a plane wall name"},
@@ -577,7 +580,10 @@ mode = "triple"
 offsets = [-0.15, 0.33, 0]
 youngs_modulus = 70e9
 class_ratio = 1.25
+freeze_scope = "local"
 freeze_density = 3e9
+freeze_held_density = 1e30
+freeze_local_reach = 1.0
 freeze_stiffness = 1e3
 freeze_local_damping = 0.9
 freeze_overlap_fraction = 1e-4
