@@ -1,7 +1,7 @@
 // Measurements on demand from the contacts of the last step: the average
 // stress of each ball (World::particleStress, dem-models.md §11) with its
 // principal values (particle_stress.h), and the load on each wall
-// (World::wallForces).
+// (World::wallForces), and which balls touch (World::touchingContacts).
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <numbers>
@@ -47,8 +47,8 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 
 }  // namespace
 
-/// Calls pair(i, j, point, force on i) for every touching ball pair and
-/// wall(i, wall, point, force on i) for every touching ball-wall contact, with
+/// Calls pair(i, j, point, force on i, overlap) for every touching ball pair and
+/// wall(i, wall, point, force on i, overlap) for every touching ball-wall contact, with
 /// the elastic contact force (normal spring at the overlap the law sees, and the
 /// shear spring of the last step; no dashpots) of the state at the current time:
 /// the balls where the last step moved them, the walls where their motion puts
@@ -72,7 +72,7 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       double secant, tangent;
       Law::normal(pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), secant,
                   tangent);
-      pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal));
+      pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal), overlap);
     }
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
       if (!history.wall_touch[c]) continue;
@@ -83,7 +83,7 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       if (overlap <= 0) continue;
       double secant, tangent;
       Law::normal(wallProps(i, wk), overlap, p.radius[i], secant, tangent);
-      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal));
+      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal), overlap);
     }
   }
 }
@@ -91,8 +91,8 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
 template <class Law>
 std::vector<Vec3> World::Impl::wallLoads() const {
   std::vector<Vec3> load(model.walls.size(), Vec3::Zero());
-  forEachElasticContact<Law>([](std::size_t, std::uint32_t, const Vec3&, const Vec3&) {},
-                             [&](std::size_t, std::uint32_t wk, const Vec3&, const Vec3& on_ball) {
+  forEachElasticContact<Law>([](std::size_t, std::uint32_t, const Vec3&, const Vec3&, double) {},
+                             [&](std::size_t, std::uint32_t wk, const Vec3&, const Vec3& on_ball, double) {
                                load[wk] -= on_ball;  // the wall feels minus the force on the ball
                              });
   return load;
@@ -105,13 +105,34 @@ std::vector<Vec3> World::wallForces() const {
 }
 
 template <class Law>
+TouchingContacts World::Impl::touching() const {
+  TouchingContacts t;
+  forEachElasticContact<Law>(
+      [&](std::size_t i, std::uint32_t j, const Vec3&, const Vec3&, double overlap) {
+        t.pairs.emplace_back(static_cast<std::uint32_t>(std::min<std::size_t>(i, j)),
+                             static_cast<std::uint32_t>(std::max<std::size_t>(i, j)));
+        t.pair_overlap.push_back(overlap);
+      },
+      [&](std::size_t i, std::uint32_t wk, const Vec3&, const Vec3&, double overlap) {
+        t.walls.emplace_back(static_cast<std::uint32_t>(i), wk);
+        t.wall_overlap.push_back(overlap);
+      });
+  return t;
+}
+
+TouchingContacts World::touchingContacts() const {
+  return impl_->model.contact.law == ContactLaw::Linear ? impl_->touching<detail::LinearLaw>()
+                                                        : impl_->touching<detail::HertzMindlinLaw>();
+}
+
+template <class Law>
 void World::Impl::contactStress(std::vector<Mat3>& sum) const {
   forEachElasticContact<Law>(
-      [&](std::size_t i, std::uint32_t j, const Vec3& point, const Vec3& on_i) {
+      [&](std::size_t i, std::uint32_t j, const Vec3& point, const Vec3& on_i, double) {
         sum[i] += stressMoment(point - p.position[i], on_i);
         sum[j] += stressMoment(point - p.position[j], -on_i);
       },
-      [&](std::size_t i, std::uint32_t, const Vec3& point, const Vec3& on_i) {
+      [&](std::size_t i, std::uint32_t, const Vec3& point, const Vec3& on_i, double) {
         sum[i] += stressMoment(point - p.position[i], on_i);
       });
 }

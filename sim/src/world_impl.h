@@ -352,6 +352,7 @@ struct World::Impl {
   void forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const;
   template <class Law> void contactStress(std::vector<geometry::Mat3>& sum) const;
   template <class Law> std::vector<Vec3> wallLoads() const;
+  template <class Law> TouchingContacts touching() const;
   // 8. integrate (stages/integrate.cpp; integrate() below is also fused into stage 3)
   void integrateStage(const StepPlan& plan, StepChecks& checks);
   void integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h, StepChecks& c);

@@ -300,6 +300,7 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
     INFO("scope " << crusher::freezeScopeName(scope));
     crusher::FreezeSettings settings;  // the defaults
     settings.scope = scope;
+    settings.stall_max_overlap = 0.01;  // the pinched row keeps 0.005 (the default 3e-4 would call it crowded)
     const std::vector<std::uint32_t> fragments{0, 1};
     // Snug: 0.1 mm (0.02 of the radius) at the split, 25 um (0.005) kept, within
     // freeze_stall_max_overlap. (Parting from a deeper overlap the pair swings past
@@ -446,6 +447,51 @@ TEST_CASE(
   CHECK(alone.reach_widenings == 0);
   CHECK(alone.balls == 2);
   CHECK(alone.end == crusher::FreezeEnd::Converged);
+}
+
+TEST_CASE("a local freeze moves the neighbours that bore no load like fragments and holds the loaded ones, "
+          "World::touchingContacts tells them apart",
+          "[crusher]") {
+  const std::vector<std::uint32_t> fragments{0, 1};
+  const crusher::FreezeSettings local;
+  // The tight row: the fragments overlap each other and fragment 0 the left wall
+  // (by 0.5 mm); the rock ball only just meets fragment 1 (no overlap: not
+  // touching). None before the first step.
+  FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
+  sim::World world(tight.model, tight.state, 1);
+  using Pair = std::pair<std::uint32_t, std::uint32_t>;
+  CHECK(world.touchingContacts().pairs.empty());
+  world.step();
+  const sim::TouchingContacts t = world.touchingContacts();
+  CHECK(t.pairs == std::vector<Pair>{{0, 1}});
+  CHECK(std::count(t.walls.begin(), t.walls.end(), Pair{0, 0}) == 1);
+  CHECK(std::none_of(t.walls.begin(), t.walls.end(), [](const Pair& c) { return c.first == 1; }));
+
+  // The free row: the rock ball touches only fragment 1 (its parent's place). Loose,
+  // it is pushed aside with the fragments; loaded (say it touched another ball), it
+  // is held where it was.
+  const Vec3 rock_start = fragmentRow(2e-3, std::nullopt).state.particles.position[2];
+  FreezeCase loose = fragmentRow(2e-3, std::nullopt), loaded = fragmentRow(2e-3, std::nullopt);
+  const crusher::FreezeResult rl =
+      crusher::freezeFragments(loose.model, loose.state, fragments, local, 1, {false, false, false});
+  const crusher::FreezeResult rh =
+      crusher::freezeFragments(loaded.model, loaded.state, fragments, local, 1, {false, false, true});
+  INFO("loose: " << rl.cycles << " cycles, loaded: " << rh.cycles << " cycles");
+  CHECK(rl.end == crusher::FreezeEnd::Converged);
+  CHECK(rh.end == crusher::FreezeEnd::Converged);
+  CHECK(rl.moved_neighbours == 1);
+  CHECK(rh.moved_neighbours == 0);
+  CHECK(loose.state.particles.position[2].x() > rock_start.x());  // pushed along +x, away from the pair
+  CHECK(loaded.state.particles.position[2] == rock_start);
+  // Parted: no mover overlaps anything beyond the criterion.
+  const sim::ParticleState& p = loose.state.particles;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = i + 1; j < 3; ++j)
+      CHECK(2 * p.radius[0] - (p.position[i] - p.position[j]).norm() <= local.overlap_fraction * p.radius[0]);
+  // One flag per ball, or none.
+  FreezeCase bad = fragmentRow(2e-3, std::nullopt);
+  CHECK_THROWS_WITH(crusher::freezeFragments(bad.model, bad.state, fragments, local, 1, {false}),
+                    Contains("one `loaded` flag per ball"));
 }
 
 TEST_CASE("a stop request during a freeze ends it at once and leaves the state as it was before the breakage",

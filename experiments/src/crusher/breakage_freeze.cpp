@@ -72,6 +72,21 @@ double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_
   return e;
 }
 
+/// The largest overlap of any of `movers` with a wall, over its radius. The walls
+/// are held, so a fragment pressed into one by its neighbours can stay there; handed
+/// back, that overlap would be at the wall's stiffness (1e13 N/m in series with the
+/// ball's) and break it again at the next check.
+double wallOverlapFraction(const sim::World& world, const std::vector<std::uint32_t>& movers) {
+  const sim::ParticleState& p = world.particles();
+  std::vector<bool> is_mover(p.size(), false);
+  for (const std::uint32_t m : movers) is_mover[m] = true;
+  const sim::TouchingContacts t = world.touchingContacts();
+  double worst = 0;
+  for (std::size_t k = 0; k < t.walls.size(); ++k)
+    if (is_mover[t.walls[k].first]) worst = std::max(worst, t.wall_overlap[k] / p.radius[t.walls[k].first]);
+  return worst;
+}
+
 /// Whether the largest overlap has stopped falling: the samples (cycle, overlap)
 /// of the last `window` cycles, the oldest at or before its start.
 class OverlapStall {
@@ -173,7 +188,14 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
         result.end = FreezeEnd::Interrupted;
         return result;
       }
-      result.max_overlap = fragmentOverlaps(m, world.particles(), fragments).max_fraction;
+      // The contacts (with the walls' overlaps) are known after the first step.
+      if (result.cycles == 0) {
+        world.step();
+        ++result.cycles;
+        continue;
+      }
+      result.max_overlap = std::max(fragmentOverlaps(m, world.particles(), fragments).max_fraction,
+                                    wallOverlapFraction(world, fragments));
       result.kinetic_energy = kineticEnergy(world.particles(), moving);
       const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;
       const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample
@@ -243,7 +265,7 @@ const char* freezeScopeName(FreezeScope scope) {
 
 FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
                              const std::vector<std::uint32_t>& fragments, const FreezeSettings& s,
-                             int threads) {
+                             int threads, const std::vector<bool>& loaded) {
   const sim::ParticleState& p = state.particles;
   if (s.scope == FreezeScope::All || p.clumps.size() > 0) {  // withoutBalls would take clumps whole
     sim::WorldState after;
@@ -256,13 +278,22 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     }
     return result;
   }
+  if (!loaded.empty() && loaded.size() != p.size())
+    throw std::invalid_argument("freezeFragments: one `loaded` flag per ball is needed");
+  std::vector<bool> is_fragment(p.size(), false);
+  for (const std::uint32_t f : fragments) is_fragment[f] = true;
   double largest = 0;  // m, the largest fragment's diameter
   for (const std::uint32_t f : fragments) largest = std::max(largest, 2 * p.radius[f]);
   FreezeResult total;
   for (double reach = s.local_reach * largest;; reach *= 2) {
     const std::vector<bool> local = localBalls(p, fragments, reach);
-    std::vector<std::uint32_t>
-        full_row;  // local row -> the run's row (withoutBalls keeps the order)
+    // The balls that move: the fragments, and the neighbours that bore no load
+    // (they touched nothing but the parents), which the fragments push aside as
+    // they would with every ball in. The loaded ones are held.
+    std::vector<std::uint32_t> movers = fragments;
+    for (std::uint32_t i = 0; i < p.size(); ++i)
+      if (local[i] && !is_fragment[i] && !loaded.empty() && !loaded[i]) movers.push_back(i);
+    std::vector<std::uint32_t> full_row;  // local row -> the run's row (withoutBalls keeps the order)
     std::vector<std::uint32_t> local_row(p.size(), UINT32_MAX);
     for (std::uint32_t i = 0; i < p.size(); ++i)
       if (local[i]) {
@@ -271,47 +302,48 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
       }
     std::vector<bool> outside(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) outside[i] = !local[i];
-    std::vector<std::uint32_t> local_fragments;
+    std::vector<std::uint32_t> local_movers;
     std::vector<bool> held(full_row.size(), true);
-    for (const std::uint32_t f : fragments) {
-      local_fragments.push_back(local_row[f]);
-      held[local_row[f]] = false;
+    for (const std::uint32_t m : movers) {
+      local_movers.push_back(local_row[m]);
+      held[local_row[m]] = false;
     }
     sim::WorldState after;
-    const FreezeResult result = runFreeze(model, sim::withoutBalls(state, outside), local_fragments,
+    const FreezeResult result = runFreeze(model, sim::withoutBalls(state, outside), local_movers,
                                           held, s, threads, state.time, after);
     const std::uint64_t cycles = total.cycles + result.cycles;
     const int widenings = total.reach_widenings;
     total = result;
     total.cycles = cycles;
     total.reach_widenings = widenings;
+    total.moved_neighbours = movers.size() - fragments.size();
     if (result.end != FreezeEnd::Converged && result.end != FreezeEnd::Stalled) return total;
     std::vector<Vec3> moved;
-    for (const std::uint32_t f : local_fragments) moved.push_back(after.particles.position[f]);
-    if (touchesOutside(p, fragments, moved, local) && full_row.size() < p.size()) {
+    for (const std::uint32_t m : local_movers) moved.push_back(after.particles.position[m]);
+    if (touchesOutside(p, movers, moved, local) && full_row.size() < p.size()) {
       ++total.reach_widenings;  // it travelled beyond the reach: again, wider
       continue;
     }
-    std::vector<bool> is_fragment(p.size(), false);
-    for (std::size_t k = 0; k < fragments.size(); ++k) {
-      is_fragment[fragments[k]] = true;
-      state.particles.position[fragments[k]] = moved[k];
+    std::vector<bool> is_mover(p.size(), false);
+    for (std::size_t k = 0; k < movers.size(); ++k) {
+      is_mover[movers[k]] = true;
+      state.particles.position[movers[k]] = moved[k];
     }
-    // History: the held balls keep theirs, the fragments' comes from the freeze.
+    // History: the held balls keep theirs, the movers' comes from the freeze.
     std::vector<sim::PairHistory> pairs;
     for (const sim::PairHistory& h : state.pair_history)
-      if (!is_fragment[h.i] && !is_fragment[h.j]) pairs.push_back(h);
+      if (!is_mover[h.i] && !is_mover[h.j]) pairs.push_back(h);
     for (sim::PairHistory h : after.pair_history) {
       h.i = full_row[h.i];
       h.j = full_row[h.j];
-      if (is_fragment[h.i] || is_fragment[h.j]) pairs.push_back(h);
+      if (is_mover[h.i] || is_mover[h.j]) pairs.push_back(h);
     }
     std::vector<sim::WallHistory> walls;
     for (const sim::WallHistory& h : state.wall_history)
-      if (!is_fragment[h.particle]) walls.push_back(h);
+      if (!is_mover[h.particle]) walls.push_back(h);
     for (sim::WallHistory h : after.wall_history) {
       h.particle = full_row[h.particle];
-      if (is_fragment[h.particle]) walls.push_back(h);
+      if (is_mover[h.particle]) walls.push_back(h);
     }
     state.pair_history = std::move(pairs);
     state.wall_history = std::move(walls);

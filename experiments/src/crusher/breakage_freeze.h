@@ -14,7 +14,9 @@
 //   - its own step: the automatic step of that model (the freeze's masses and
 //     stiffnesses), not the run's;
 //   - cycled until (a) no fragment overlaps a ball by more than overlap_fraction of
-//     the smaller radius and (b) the kinetic energy is below kinetic_fraction of the
+//     the smaller radius, nor a wall by more than that fraction of its own (a
+//     fragment pressed into a held wall comes back at the wall's stiffness and
+//     breaks again: until 2026-12-04 walls were not looked at), and (b) the kinetic energy is below kinetic_fraction of the
 //     artificial energy the fragments' overlaps stored at the start (at the freeze
 //     stiffness) [X]: pushed apart, that energy dissipated ("converged"). Fragments
 //     that separate into free space coast (local damping stops accelerating motion
@@ -32,8 +34,12 @@
 //     it leaves sideways only when a slow instability grows: in the 200-ball run
 //     the largest overlap did not fall below 0.34 for longer than the window, was
 //     0.005 after 200,000 cycles and met the criterion (a) after 206,000), and
-//     handed back at rock stiffness it would fire the fragments apart. The bound is of the order of the run's own contacts: its parents
-//     broke at q of 200-530 MPa, overlaps of q / (0.9 E_c) = 0.003-0.008.
+//     handed back at rock stiffness it would fire the fragments apart. The bound (3e-4;
+//     0.01 until 2026-12-04) is what a ball can take: an overlap f R at k = 4 R E_c
+//     loads it to q = 0.9 k f R / d^2 = 0.9 E_c f, 19 MPa at 3e-4, below the weakest
+//     strengths of the feed (q0 25 MPa at 21 mm). At 0.01 (630 MPa) every stall
+//     handed back a contact that broke a ball at the next check: in a 200-ball run
+//     10 of the 11 fragments of stalled freezes that broke again did so then.
 //     The window is in the heaviest fragment's own time scale sqrt(m/k) (freeze mass
 //     and stiffness), not in cycles: the freeze's step is set by the unbroken balls
 //     (rock stiffness at the huge density), so a fixed number of cycles is a tiny or
@@ -68,7 +74,11 @@
 //     and the balls beyond the reach, which the fragments cannot touch, are left
 //     out. Should a fragment end touching a ball outside the set (it travelled
 //     further than the reach), the reach doubles and the freeze runs again from
-//     the start. Only the fragments' positions and contact history come back; the
+//     the start. Neighbours that bore no load at the breakage (they touched
+//     nothing but the parents: loose balls rattling in the chamber) are not held
+//     but move like fragments (soft, at the freeze density), so the fragments can
+//     push them aside as they would with every ball in; held, they would pin the
+//     fragments. Only the movers' positions and contact history come back; the
 //     held balls keep their own. A state with clumps is frozen whole ("all").
 //
 // Only the positions (and the contact history at them) come back; masses,
@@ -95,7 +105,7 @@ struct FreezeSettings {
   double kinetic_fraction = 0.2;  // kinetic energy / the fragments' initial artificial energy that ends it
   double stall_tolerance = 0.01;   // relative fall of the largest overlap below which it has stalled
   double stall_window = 2.0;       // over this many of the heaviest fragment's sqrt(m/k); 0 = no stall rule
-  double stall_max_overlap = 0.01; // a stall ends the freeze only with the largest overlap at most this
+  double stall_max_overlap = 3e-4; // a stall ends the freeze only with the largest overlap at most this
   std::int64_t max_cycles = 1000000;
   bool defer_crowded = true;       // at max_cycles: end "crowded" (true) or stop the run
   std::int64_t check_cycles = 20;  // cycles between looks at the criterion (at most a quarter of the stall window)
@@ -114,10 +124,11 @@ struct FreezeResult {
   double dt = 0.0;                 // s, the freeze's own step
   std::uint64_t stall_window_cycles = 0;  // the stall rule's window in cycles (0: off)
   double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
-  double max_overlap = 0.0;        // largest fragment overlap / smaller radius at the end
+  double max_overlap = 0.0;        // largest fragment overlap / smaller radius (walls: / its radius) at the end
   double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the fragments')
   std::size_t balls = 0;           // balls in the freeze World (the last run of it)
   int reach_widenings = 0;         // "local": runs repeated with the reach doubled
+  std::size_t moved_neighbours = 0;  // "local": neighbours that moved with the fragments (not loaded)
 };
 
 /// Relaxes the balls `fragments` (rows of state.particles) of `state` at time
@@ -125,9 +136,14 @@ struct FreezeResult {
 /// history are those after the freeze (with scope "local" the fragments' only),
 /// everything else as it was. Throws std::runtime_error (the settings named) when
 /// max_cycles pass before either way out and defer_crowded is off.
+/// `loaded` (scope "local"; one flag per ball of `state`, or empty): the balls that
+/// bear load, touching a ball other than the broken parents or a wall at the
+/// breakage (sim::World::touchingContacts). A neighbour not loaded moves in the
+/// freeze like a fragment (soft, at `density`, in the criteria, its position
+/// back); empty: every neighbour is held.
 FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
                              const std::vector<std::uint32_t>& fragments, const FreezeSettings& settings,
-                             int threads);
+                             int threads, const std::vector<bool>& loaded = {});
 
 /// The largest overlap of any of `fragments` with any ball, over the smaller radius
 /// of the pair, and the energy their overlaps store at the stiffnesses of `model`

@@ -178,6 +178,18 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   sim::WorldState state = world->exportState();
   std::vector<bool> remove(p.size(), false);
   for (const Broken& b : broken) remove[b.row] = true;
+  // The balls that bear load without the parents (a wall, or a ball that stays):
+  // the local freeze holds them and lets the others move (breakage_freeze.h).
+  std::vector<bool> loaded_before(p.size(), false);
+  const sim::TouchingContacts touching = world->touchingContacts();
+  for (const auto& [i, wall] : touching.walls) loaded_before[i] = true;
+  for (const auto& [i, j] : touching.pairs) {
+    if (!remove[j]) loaded_before[i] = true;
+    if (!remove[i]) loaded_before[j] = true;
+  }
+  std::vector<bool> loaded;  // rows of `state` (withoutBalls keeps the order; no clumps)
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!remove[i]) loaded.push_back(loaded_before[i]);
   state = sim::withoutBalls(std::move(state), remove);
   std::vector<std::uint32_t> rows;
   const std::size_t first_event = events_.size();
@@ -201,7 +213,9 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     }
     events_.push_back(std::move(e));
   }
-  const crusher::FreezeResult freeze = crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads);
+  loaded.resize(state.particles.size(), false);  // the fragments
+  const crusher::FreezeResult freeze =
+      crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads, loaded);
   if (freeze.end == crusher::FreezeEnd::Interrupted || freeze.end == crusher::FreezeEnd::Crowded) {
     events_.resize(first_event);
     next_id_ = next_id_before;
@@ -233,6 +247,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
   max_freeze_balls_ = std::max(max_freeze_balls_, freeze.balls);
   reach_widenings_ += static_cast<std::uint64_t>(freeze.reach_widenings);
+  moved_neighbours_ += freeze.moved_neighbours;
   world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
   return true;
 }
@@ -284,6 +299,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freeze_scope"] = crusher::freezeScopeName(s_.freeze.scope);
   b["max_freeze_balls"] = max_freeze_balls_;
   b["freeze_reach_widenings"] = reach_widenings_;
+  b["freeze_moved_neighbours"] = moved_neighbours_;
   nlohmann::json deferred = nlohmann::json::array();
   for (const Deferral& d : deferrals_)
     deferred.push_back({{"time_s", d.time}, {"parents", d.parents}, {"freeze_cycles", d.cycles},

@@ -111,6 +111,7 @@ class CrusherBreakage {
   double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left
   std::size_t max_freeze_balls_ = 0;      // the most balls a freeze World held
   std::uint64_t reach_widenings_ = 0;     // "local" freezes run again with a wider reach
+  std::uint64_t moved_neighbours_ = 0;    // "local": loose neighbours the freezes moved
 };
 
 }  // namespace rocklab::experiments

@@ -293,17 +293,17 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "offsets", "", "Fragment centres along the minor principal stress direction, in parent radii, one per fragment, each fragment inside the parent. Default: triple [-0.157, 0.331, 0] (60 % and 30 % internally tangent at opposite ends, 10 % at the centre), equal [-0.206, 0.206]."},
       {"experiment.crusher.breakage", "youngs_modulus", "Pa", "E_c of the fragments' stiffness k = 4 R E_c (Eq 6-14), R the middle of the fragment's size class."},
       {"experiment.crusher.breakage", "class_ratio", "", "Width of the fragments' size classes (diameters min_diameter x ratio^i to ^(i+1)); each class is a material with its own k."},
-      {"experiment.crusher.breakage", "freeze_scope", "", "Who takes part in the freeze: \"local\" the fragments and the balls within freeze_local_reach of them, held still (the freeze's step is the fragments' own, a few dozen balls); \"all\" every ball of the run at freeze_density (§g.6 step 3 as written; the step is set by the unbroken balls' rock stiffness).", "\"local\", \"all\""},
+      {"experiment.crusher.breakage", "freeze_scope", "", "Who takes part in the freeze: \"local\" the fragments and the balls within freeze_local_reach of them, those that bear load held still and the loose ones moving like fragments (the freeze's step is the fragments' own, a few dozen balls); \"all\" every ball of the run at freeze_density (§g.6 step 3 as written; the step is set by the unbroken balls' rock stiffness).", "\"local\", \"all\""},
       {"experiment.crusher.breakage", "freeze_density", "kg/m^3", "Density during the freeze (§g.6 step 3): every ball's (scope \"all\") or the fragments' (\"local\")."},
       {"experiment.crusher.breakage", "freeze_held_density", "kg/m^3", "Scope \"local\": the density of the held neighbours, so huge that the fragments cannot move them."},
       {"experiment.crusher.breakage", "freeze_local_reach", "", "Scope \"local\": the neighbours taken in, within this many largest-fragment diameters of a fragment (surface to surface); a fragment that ends touching a ball beyond it doubles the reach and the freeze runs again."},
       {"experiment.crusher.breakage", "freeze_stiffness", "N/m", "The fragments' kn and ks during the freeze (§g.6 step 4)."},
       {"experiment.crusher.breakage", "freeze_local_damping", "", "Local damping alpha during the freeze (§g.6 step 5; viscous damping off)."},
-      {"experiment.crusher.breakage", "freeze_overlap_fraction", "", "The freeze may end when no fragment overlaps a ball by more than this fraction of the smaller radius."},
+      {"experiment.crusher.breakage", "freeze_overlap_fraction", "", "The freeze may end when no fragment overlaps a ball by more than this fraction of the smaller radius, nor a wall by more than this fraction of its own."},
       {"experiment.crusher.breakage", "freeze_kinetic_fraction", "", "...and the kinetic energy is below this fraction of the energy the fragments' overlaps stored at the freeze stiffness."},
       {"experiment.crusher.breakage", "freeze_stall_tolerance", "", "The freeze also ends (\"stalled\") when the kinetic criterion holds and the largest fragment overlap has not fallen below (1 - this) of its value freeze_stall_window ago: fragments pinched between the held walls or heavy neighbours, whose overlap cannot reach freeze_overlap_fraction."},
       {"experiment.crusher.breakage", "freeze_stall_window", "", "The window of the stall rule in the heaviest fragment's time scale sqrt(m/k) at the freeze density and stiffness (not in cycles: the freeze's step is set by the unbroken balls); 0 = no stall rule (only the overlap criterion ends a freeze)."},
-      {"experiment.crusher.breakage", "freeze_stall_max_overlap", "", "The stall rule ends a freeze only when the largest fragment overlap is at most this fraction of the smaller radius (higher plateaus are squeezes the fragments leave later; handed back at rock stiffness they would fire the fragments apart)."},
+      {"experiment.crusher.breakage", "freeze_stall_max_overlap", "", "The stall rule ends a freeze only when the largest fragment overlap (with a ball or a wall) is at most this fraction of the smaller radius: handed back at rock stiffness k = 4 R E_c an overlap f R loads a ball to q = 0.9 E_c f (19 MPa at the default 3e-4, below the feed's strengths); higher plateaus are squeezes the fragments leave later, or crowded freezes."},
       {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles is crowded: its fragments found no room (freeze_defer_crowded says what follows)."},
       {"experiment.crusher.breakage", "freeze_defer_crowded", "", "After a crowded freeze: true keeps its parents whole for defer_time (results.json breakage.deferred); false stops the run with the criteria's values."},
       {"experiment.crusher.breakage", "defer_time", "s", "How long a ball whose fragments found no room stays whole before it may break again."},
@@ -590,7 +590,7 @@ freeze_overlap_fraction = 1e-4
 freeze_kinetic_fraction = 0.2
 freeze_stall_tolerance = 0.01
 freeze_stall_window = 2
-freeze_stall_max_overlap = 0.01
+freeze_stall_max_overlap = 3e-4
 freeze_max_cycles = 1000000
 freeze_check_cycles = 20
 freeze_defer_crowded = true

@@ -33,6 +33,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rocklab/sim/bonds.h"
@@ -101,6 +102,16 @@ struct WorldStats {
   std::string far_travel;
 };
 
+/// The contacts that touch (overlap > 0) in the state at the current time: ball
+/// pairs (first < second) and ball–wall contacts (ball, wall index), each with
+/// its overlap (m, the one the contact law sees).
+struct TouchingContacts {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  std::vector<double> pair_overlap;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> walls;
+  std::vector<double> wall_overlap;
+};
+
 class World {
  public:
   /// Builds a world; validates the model, audits the time step (throws
@@ -152,6 +163,10 @@ class World {
   /// elastic contact forces of the last step (no dashpots: with contact damping
   /// the dashpots' share is left out). A platen's load cell.
   std::vector<Vec3> wallForces() const;
+  /// Which balls touch which balls and walls, from the contacts of the last step
+  /// (the ones particleStress sums; empty before the first step). The crusher's
+  /// freeze tells load-bearing neighbours from loose ones with it.
+  TouchingContacts touchingContacts() const;
   /// Work (J) the moving walls have done on the balls (WorldState::moving_wall_work
   /// says since when): every step, each wall contact's force, dashpots included,
   /// times the wall's velocity at the contact; summed in ball order, so the same on
