@@ -12,7 +12,6 @@
 #include "rocklab/render/renderer.h"
 #include "rocklab/track/detect.h"
 #include "rocklab/track/shape_fit.h"
-#include "rocklab/track/smooth.h"
 #include "track_scenes.h"
 
 using namespace rocklab;
@@ -142,32 +141,4 @@ TEST_CASE("shape fit settings and marker models are checked", "[track][shape-fit
   // Too few edge points: no fit.
   const ShapeFitter fitter(demoCamera(), clumpModel());
   CHECK_FALSE(fitter.fit({{1, 1}, {2, 2}}, {1.5, 1.5}));
-}
-
-TEST_CASE("smoothing a track passes a constant acceleration unbiased and lowers jitter", "[track][shape-fit]") {
-  // u = 100 + 20 t' + 3 t'² (t' in ms), v with ±0.4 px alternating jitter, every frame
-  // but one at 500 fps; centres only on some points.
-  Track track;
-  for (int k = 0; k < 60; ++k) {
-    if (k == 30) continue;  // a missed frame
-    TrackPoint p;
-    p.frame = k;
-    p.time = k / kFrameRate;
-    const double ms = 1e3 * p.time;
-    p.pixel = {100 + 0.02 * ms + 0.003 * ms * ms, 50 + (k % 2 ? 0.4 : -0.4)};
-    if (k >= 10) p.centre = Vec3(0.001 * ms, 0.01, 0.0);
-    track.points.push_back(p);
-  }
-  Track smoothed = track;
-  smoothTrack(smoothed, 5);
-  double worst_u = 0, worst_v = 0;
-  for (std::size_t i = 0; i < track.points.size(); ++i) {
-    worst_u = std::max(worst_u, std::abs(smoothed.points[i].pixel.x - track.points[i].pixel.x));
-    worst_v = std::max(worst_v, std::abs(smoothed.points[i].pixel.y - 50.0));
-    CHECK((std::isnan(smoothed.points[i].detected.x) && std::isnan(track.points[i].detected.x)));
-  }
-  CHECK(worst_u < 1e-9);  // px: the quadratic itself
-  CHECK(worst_v < 0.2);   // px: the ±0.4 px jitter at least halved
-  CHECK(std::isnan(smoothed.points[0].centre.x()));             // none to smooth
-  CHECK(std::abs(smoothed.points[40].centre.x() - track.points[40].centre.x()) < 1e-12);
 }

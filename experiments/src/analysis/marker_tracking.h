@@ -16,7 +16,6 @@
 
 #include "rocklab/geometry/camera.h"
 #include "rocklab/geometry/packing.h"
-#include "rocklab/track/smooth.h"
 #include "rocklab/track/stitch.h"
 #include "rocklab/track/tracker.h"
 #include "rocklab/track/velocity.h"
@@ -47,9 +46,9 @@ class MarkerTracking {
   struct Result {
     std::vector<track::Track> tracks;               // stitched
     std::vector<track::MarkerVelocity> velocities;  // one per track
-    // With the shape fit, for comparison: the same tracks' velocities with other
-    // depths (per frame, or the fitted pixels on the plane of the marker centres)
-    // and without the smoothing in time, one per track each.
+    // With the shape fit, for comparison: the same tracks' velocities at other
+    // depths (the fitted depth per frame, or the fitted pixels on the plane of the
+    // marker centres), one per track each.
     std::vector<std::pair<std::string, std::vector<track::MarkerVelocity>>> depth_variants;
     bool shape_fit = false;
     track::Tracker::ShapeFitCounts shape_fit_counts;
