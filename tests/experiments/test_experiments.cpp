@@ -152,7 +152,7 @@ TEST_CASE("chute: a short clump chute discharges and reports its markers", "[exp
   CHECK(r["cameras"][0]["gl_renderer"].get<std::string>().size() > 0);
   // The tracker (images only) against the truth: every marker followed over the
   // 100 mm window, each within 2 % (issue 25; the model-based position,
-  // track_position = "shape": 10 of 10, max 1.25 %, RMS 0.61 %; the centroid
+  // track_position = "shape": 10 of 10, max 1.27 %, RMS 0.66 %; the centroid
   // measured max 2.50 %, RMS 0.87 %). Before the prediction-seeded split, the
   // ambiguity ends and stitching, 6 of 7 were within 2.5 % and one +10.7 %: hidden
   // for 65 ms, its track resumed on a blob ahead.
