@@ -37,7 +37,7 @@ void Tracker::add(int frame, double time, const cv::Mat& bgr) {
     ++counts_.fitted;
     if (pose->searched) ++counts_.searched;
     linker_.refineLastPoint(id, pose->pixel, pose->centre);
-    seeds_[id] = {frame, *pose, d.centroid};
+    seeds_[id] = {*pose, d.centroid};
     fitted.emplace_back(id, pose->pixel);
   }
   // One marker fitted twice: the track with fewer points (the younger on a tie)

@@ -53,7 +53,6 @@ class Tracker {
 
  private:
   struct Seed {
-    int frame = 0;
     MarkerPose pose;
     cv::Point2d centroid;  // px, the detection's centroid the pose was fitted to
   };
