@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 #include <cstdio>
 #include <numeric>
 #include <random>
@@ -141,4 +143,31 @@ TEST_CASE("the linker tolerates empty frames and re-finds a marker after missed 
   LinkSettings bad;
   bad.max_distance_px = 0;
   CHECK_THROWS_WITH(Linker(bad), Catch::Contains("link.max_distance_px"));
+}
+
+TEST_CASE("a refined point keeps the linker on the centroids, a withdrawn track ends and an empty one is gone",
+          "[track][link]") {
+  Linker linker;
+  linker.add(0, 0.000, {at(10, 10), at(60, 10)});
+  REQUIRE(linker.lastTrackIds() == std::vector<int>{0, 1});
+  // The shape fit moves track 0's reported point; the linker still predicts from the centroid.
+  linker.refineLastPoint(0, {11.5, 10.0}, {0.1, 0.2, 0.3});
+  linker.add(1, 0.002, {at(12, 10), at(62, 10)});
+  CHECK(linker.lastTrackIds() == std::vector<int>{0, 1});
+  const std::vector<Track> both = linker.tracks();
+  CHECK(both[0].points[0].pixel == cv::Point2d(11.5, 10.0));
+  CHECK(both[0].points[0].detected == cv::Point2d(10, 10));
+  CHECK(both[0].points[0].centre.x() == 0.1);
+  CHECK(std::isnan(both[0].points[1].centre.x()));
+  // Track 1 withdraws in frame 1: its frame-1 point goes and it is no longer extended.
+  linker.withdraw(1);
+  CHECK_THROWS_AS(linker.withdraw(1), std::invalid_argument);
+  linker.add(2, 0.004, {at(14, 10), at(64, 10)});
+  const std::vector<Track> after = linker.tracks();
+  REQUIRE(after.size() == 3);
+  CHECK(after[1].points.size() == 1);  // frame 0 only
+  CHECK(after[2].points.front().frame == 2);
+  // A track withdrawn in its only frame has no point left and is left out.
+  linker.withdraw(2);
+  CHECK(linker.tracks().size() == 2);
 }

@@ -9,15 +9,6 @@
 
 namespace rocklab::track::detail {
 
-namespace {
-
-// Redness of a BGR pixel: r − max(g, b), ≥ 0. Grey (and its white specular
-// highlight added to red) contributes nothing extra; the antialiased edge of a
-// marker counts in proportion to its coverage.
-double redness(const cv::Vec3b& p) { return std::max(0, int(p[2]) - std::max(int(p[0]), int(p[1]))); }
-
-}  // namespace
-
 std::vector<cv::Point> rowEnds(const std::vector<cv::Point>& pixels) {
   if (pixels.empty()) return {};
   int v0 = pixels.front().y, v1 = v0;

@@ -134,7 +134,12 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     }
     if (pieces.size() > 1) {
       found.clear();
-      for (const detail::Blob& piece : pieces) found.push_back(detail::measureBlob(bgr, piece));
+      for (const detail::Blob& piece : pieces) {
+        found.push_back(detail::measureBlob(bgr, piece));
+        if (settings.edge_points) found.back().edge_points = detail::blobEdges(bgr, piece);
+      }
+    } else if (settings.edge_points) {
+      found[0].edge_points = detail::blobEdges(bgr, blob);
     }
     for (const Detection& d : found) {
       if (d.area_px < settings.min_area_px || d.area_px > settings.max_area_px) continue;

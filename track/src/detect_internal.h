@@ -1,6 +1,7 @@
 #pragma once
 // The stages of detectMarkers (detect.h), one file each.
 #include <cstdint>
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -67,8 +68,21 @@ Blob componentBlob(const Components& components, int label, const cv::Rect& box,
 /// coincide), by row: the same convex hull, and so the same enclosing circle.
 std::vector<cv::Point> rowEnds(const std::vector<cv::Point>& pixels);
 
+/// Redness of a BGR pixel: r − max(g, b), ≥ 0. Grey (and its white specular
+/// highlight added to red) contributes nothing extra; the antialiased edge of a
+/// marker counts in proportion to its coverage.
+inline double redness(const cv::Vec3b& p) { return std::max(0, int(p[2]) - std::max(int(p[0]), int(p[1]))); }
+
 /// Stage 5: redness-weighted centroid over core and rim, area and fill of the core.
 Detection measureBlob(const cv::Mat& bgr, const Blob& blob);
+
+/// Stage 5b (DetectorSettings::edge_points): sub-pixel points of the blob's outline,
+/// one per core pixel and 4-neighbour rim pixel (a cut between two pieces of a split
+/// blob is no edge: the other piece's pixels are no rim). Along the step from core
+/// pixel p to rim pixel q the edge lies where a straight edge would give both their
+/// coverages, c = redness / the redness of full paint (the brighter of p and the core
+/// pixel behind it): at p + (c_p + c_q − ½)(q − p).
+std::vector<cv::Point2f> blobEdges(const cv::Mat& bgr, const Blob& blob);
 
 /// Stage 4: `pieces` touching markers of radius marker_radius_px → one blob each
 /// (fewer when fewer distance-transform peaks are found; the blob itself when one).

@@ -97,7 +97,7 @@ TrackingEvaluation evaluateTracks(const std::vector<Track>& tracks, const std::v
       v.add(track_point->pixel.y - truth_point->pixel.y);
       ++out.subpixel_u[static_cast<std::size_t>(subpixelBin(track_point->pixel.x, settings.subpixel_bins))];
       ++out.subpixel_v[static_cast<std::size_t>(subpixelBin(track_point->pixel.y, settings.subpixel_bins))];
-      if (const auto x = pixelToPlane(camera, track_point->pixel, plane_point, plane_normal))
+      if (const auto x = pointToWorld(camera, *track_point, plane_point, plane_normal))
         for (std::size_t a = 0; a < axes.size(); ++a) world[a].add((*x - truth_point->world).dot(axes[a].direction));
     }
   }

@@ -27,7 +27,7 @@ void writeTracksCsv(const std::filesystem::path& path, const std::vector<Track>&
   bool ok = std::fprintf(f, "frame,time_s,id,u_px,v_px,x_m,y_m,z_m\n") > 0;
   for (const auto& [frame, id, p] : rows) {
     ok = ok && std::fprintf(f, "%d,%.9g,%d,%.4f,%.4f,", frame, p->time, id, p->pixel.x, p->pixel.y) > 0;
-    if (const auto x = pixelToPlane(camera, p->pixel, plane_point, plane_normal))
+    if (const auto x = pointToWorld(camera, *p, plane_point, plane_normal))
       ok = ok && std::fprintf(f, "%.9g,%.9g,%.9g\n", x->x(), x->y(), x->z()) > 0;
     else
       ok = ok && std::fprintf(f, "nan,nan,nan\n") > 0;

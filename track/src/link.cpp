@@ -12,13 +12,17 @@ namespace rocklab::track {
 
 namespace {
 
-// Constant-velocity prediction of a track's pixel at `time`.
+// Where a point was detected: the linker links centroids to centroids, also when
+// the reported position is a shape fit's.
+cv::Point2d detectedAt(const TrackPoint& p) { return std::isnan(p.detected.x) ? p.pixel : p.detected; }
+
+// Constant-velocity prediction of a track's detected pixel at `time`.
 cv::Point2d predict(const Track& track, double time) {
   const TrackPoint& last = track.points.back();
-  if (track.points.size() < 2) return last.pixel;
+  if (track.points.size() < 2) return detectedAt(last);
   const TrackPoint& prev = track.points[track.points.size() - 2];
-  const cv::Point2d velocity = (last.pixel - prev.pixel) / (last.time - prev.time);  // px/s
-  return last.pixel + velocity * (time - last.time);
+  const cv::Point2d velocity = (detectedAt(last) - detectedAt(prev)) / (last.time - prev.time);  // px/s
+  return detectedAt(last) + velocity * (time - last.time);
 }
 
 double squaredDistance(const cv::Point2d& a, const cv::Point2d& b) {
@@ -53,6 +57,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     throw std::invalid_argument(s.str());
   }
   started_ = true;
+  last_track_ids_.assign(detections.size(), -1);
   last_frame_ = frame;
   last_time_ = time;
 
@@ -117,16 +122,20 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
         continue;
       }
     }
-    tracks_[active_[i]].points.push_back({frame, time, detections[match[i]].centroid});
+    const cv::Point2d at = detections[match[i]].centroid;
+    tracks_[active_[i]].points.push_back({frame, time, at, at});
     used[match[i]] = 1;
+    last_track_ids_[static_cast<std::size_t>(match[i])] = active_[i];
   }
   for (int i = n - 1; i >= 0; --i)
     if (closed[i]) active_.erase(active_.begin() + i);
   for (int j = 0; j < m; ++j) {
     if (used[j]) continue;
     const int id = static_cast<int>(tracks_.size());
-    tracks_.push_back({id, {{frame, time, detections[j].centroid}}});
+    const cv::Point2d at = detections[j].centroid;
+    tracks_.push_back({id, {{frame, time, at, at}}});
     active_.push_back(id);
+    last_track_ids_[static_cast<std::size_t>(j)] = id;
   }
 }
 
@@ -142,6 +151,29 @@ std::vector<cv::Point2d> Linker::predictions(int frame, double time) const {
   return out;
 }
 
-std::vector<Track> Linker::tracks() const { return tracks_; }
+std::vector<Track> Linker::tracks() const {
+  std::vector<Track> out;
+  out.reserve(tracks_.size());
+  for (const Track& t : tracks_)
+    if (!t.points.empty()) out.push_back(t);
+  return out;
+}
+
+void Linker::withdraw(int id) {
+  if (id < 0 || id >= static_cast<int>(tracks_.size()) || tracks_[static_cast<std::size_t>(id)].points.empty() ||
+      tracks_[static_cast<std::size_t>(id)].points.back().frame != last_frame_)
+    throw std::invalid_argument("Linker::withdraw: track " + std::to_string(id) + " has no point in the last frame");
+  tracks_[static_cast<std::size_t>(id)].points.pop_back();
+  std::erase(active_, id);
+}
+
+void Linker::refineLastPoint(int id, cv::Point2d pixel, const geometry::Vec3& centre) {
+  if (id < 0 || id >= static_cast<int>(tracks_.size()) || tracks_[static_cast<std::size_t>(id)].points.empty() ||
+      tracks_[static_cast<std::size_t>(id)].points.back().frame != last_frame_)
+    throw std::invalid_argument("Linker::refineLastPoint: track " + std::to_string(id) + " has no point in the last frame");
+  TrackPoint& p = tracks_[static_cast<std::size_t>(id)].points.back();
+  p.pixel = pixel;
+  p.centre = centre;
+}
 
 }  // namespace rocklab::track

@@ -22,4 +22,10 @@ std::optional<geometry::Vec3> pixelToPlane(const geometry::Camera& camera, cv::P
   return centre + s * ray;
 }
 
+std::optional<geometry::Vec3> pointToWorld(const geometry::Camera& camera, const TrackPoint& point,
+                                           const geometry::Vec3& plane_point, const geometry::Vec3& plane_normal) {
+  if (point.centre.allFinite()) return point.centre;
+  return pixelToPlane(camera, point.pixel, plane_point, plane_normal);
+}
+
 }  // namespace rocklab::track

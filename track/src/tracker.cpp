@@ -1,5 +1,7 @@
 #include "rocklab/track/tracker.h"
 
+#include <utility>
+
 namespace rocklab::track {
 
 Tracker::Tracker(TrackerSettings settings) : settings_(settings), linker_(settings.link) {
@@ -7,8 +9,54 @@ Tracker::Tracker(TrackerSettings settings) : settings_(settings), linker_(settin
   settings_.stitch.validate();
 }
 
+void Tracker::useShapeFit(ShapeFitter fitter) {
+  fitter_.emplace(std::move(fitter));
+  settings_.detector.edge_points = true;
+}
+
 void Tracker::add(int frame, double time, const cv::Mat& bgr) {
-  linker_.add(frame, time, detectMarkers(bgr, settings_.detector, linker_.predictions(frame, time)));
+  const std::vector<Detection> detections = detectMarkers(bgr, settings_.detector, linker_.predictions(frame, time));
+  linker_.add(frame, time, detections);
+  if (!fitter_) return;
+  // A seed older than the linker's reach (the marker was hidden) is still the best
+  // guess of the orientation; the fit judges it by its residual.
+  const std::vector<int> ids = linker_.lastTrackIds();
+  std::vector<std::pair<int, cv::Point2d>> fitted;  // (track id, fitted pixel) of this frame
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    const Detection& d = detections[i];
+    const int id = ids[i];
+    if (id < 0) continue;  // not linked (cannot happen: every detection extends or starts a track)
+    const auto seed = seeds_.find(id);
+    const std::optional<MarkerPose> pose =
+        seed == seeds_.end() ? fitter_->fit(d.edge_points, d.centroid)
+                             : fitter_->fit(d.edge_points, d.centroid, &seed->second.pose, seed->second.centroid);
+    if (!pose) {
+      ++counts_.unfitted;
+      continue;
+    }
+    ++counts_.fitted;
+    if (pose->searched) ++counts_.searched;
+    linker_.refineLastPoint(id, pose->pixel, pose->centre);
+    seeds_[id] = {*pose, d.centroid};
+    fitted.emplace_back(id, pose->pixel);
+  }
+  // One marker fitted twice: the track with fewer points (the younger on a tie)
+  // withdraws; the blob is then no longer cut at its prediction.
+  if (settings_.duplicate_distance_px <= 0) return;
+  const double limit2 = settings_.duplicate_distance_px * settings_.duplicate_distance_px;
+  for (std::size_t a = 0; a < fitted.size(); ++a)
+    for (std::size_t b = a + 1; b < fitted.size(); ++b) {
+      if (fitted[a].first < 0 || fitted[b].first < 0) continue;  // already withdrawn
+      const cv::Point2d d = fitted[a].second - fitted[b].second;
+      if (d.dot(d) > limit2) continue;
+      const std::size_t na = linker_.pointCount(fitted[a].first), nb = linker_.pointCount(fitted[b].first);
+      const bool a_goes = na < nb || (na == nb && fitted[a].first > fitted[b].first);
+      int& gone = a_goes ? fitted[a].first : fitted[b].first;
+      linker_.withdraw(gone);
+      seeds_.erase(gone);
+      ++counts_.duplicates;
+      gone = -1;
+    }
 }
 
 StitchResult Tracker::finish() const { return stitchTracks(linker_.tracks(), settings_.stitch, linker_.ambiguousEnds()); }

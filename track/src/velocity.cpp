@@ -89,7 +89,7 @@ MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera,
   std::vector<geometry::Vec3> world;
   std::vector<double> time;
   for (const TrackPoint& p : track.points)
-    if (const auto x = pixelToPlane(camera, p.pixel, plane_point, plane_normal)) {
+    if (const auto x = pointToWorld(camera, p, plane_point, plane_normal)) {
       world.push_back(*x);
       time.push_back(p.time);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace rocklab::experiments {
 
@@ -52,7 +53,21 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   s.stitch.max_distance_px = kStitchRadii * r_px;
   s.stitch.ambiguity_ratio = kAmbiguityRatio;
   s.stitch.velocity_points = std::max(2, static_cast<int>(std::lround(kStitchVelocityTime * camera_.frameRate)));
+  // With the shape fit, a track whose fitted centre repeats a longer track's within
+  // kDuplicateRadii marker radii follows the same marker (a blob cut in two) and
+  // ends there; two markers' centres are at least a clump's width apart.
+  constexpr double kDuplicateRadii = 0.5;
+  s.duplicate_distance_px = kDuplicateRadii * r_px;
   tracker_ = std::make_unique<track::Tracker>(s);
+}
+
+void MarkerTracking::useShapeFit(const std::vector<geometry::Sphere>& balls) {
+  track::MarkerModel model;
+  model.balls = balls;
+  model.wall_point = geometry::Vec3::Zero();
+  model.wall_normal = geometry::Vec3::UnitY();
+  tracker_->useShapeFit(track::ShapeFitter(camera_, model));
+  shape_model_ = model;
 }
 
 void MarkerTracking::addFrame(std::uint64_t frame, double time, const cv::Mat& bgr) {
@@ -69,9 +84,32 @@ MarkerTracking::Result MarkerTracking::finish() const {
   r.tracks = std::move(stitched.tracks);
   r.joins = std::move(stitched.joins);
   r.unresolved = std::move(stitched.unresolved);
-  for (const track::Track& t : r.tracks)
-    r.velocities.push_back(track::trackVelocity(t, camera_, planePoint(), geometry::Vec3::UnitY(),
-                                                -geometry::Vec3::UnitX(), measure_distance_, onset_, reference_time_));
+  auto velocitiesOf = [&](const std::vector<track::Track>& tracks) {
+    std::vector<track::MarkerVelocity> v;
+    for (const track::Track& t : tracks)
+      v.push_back(track::trackVelocity(t, camera_, planePoint(), geometry::Vec3::UnitY(), -geometry::Vec3::UnitX(),
+                                       measure_distance_, onset_, reference_time_));
+    return v;
+  };
+  if (shape_model_) {
+    r.shape_fit = true;
+    r.shape_fit_counts = tracker_->shapeFitCounts();
+    std::vector<track::Track> on_plane = r.tracks;
+    for (track::Track& t : on_plane)
+      for (track::TrackPoint& p : t.points) p.centre = geometry::Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    r.depth_variants.emplace_back("fitted depth per frame", velocitiesOf(r.tracks));
+    r.depth_variants.emplace_back("marker plane", velocitiesOf(on_plane));
+    // The depth a marker's velocity is taken at: its fitted depth, as the running
+    // median over kDepthSmoothing either side (a nearly flat clump's tilt is
+    // ill-determined frame by frame; the marker turns slowly). The positions are not
+    // smoothed: a local quadratic over 10 ms either side made the demo worse (RMS
+    // 0.60 % against 0.50 %, max 1.87 % against 1.51 %: it rounds off the start of
+    // the motion at the gate opening).
+    constexpr double kDepthSmoothing = 0.025;  // s
+    track::smoothFittedDepths(r.tracks, camera_, *shape_model_,
+                              std::max(1, static_cast<int>(std::lround(kDepthSmoothing * camera_.frameRate))));
+  }
+  r.velocities = velocitiesOf(r.tracks);
   r.frames = frames_;
   r.seconds = seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -6,13 +6,16 @@
 // centres (y = marker plane, one marker radius behind the camera-side wall).
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "rocklab/geometry/camera.h"
+#include "rocklab/geometry/packing.h"
 #include "rocklab/track/stitch.h"
 #include "rocklab/track/tracker.h"
 #include "rocklab/track/velocity.h"
@@ -28,6 +31,10 @@ class MarkerTracking {
   /// expected blob area (touching markers are split), the linking gate and the
   /// stitching gate.
   void setMarkers(double plane_y, double radius);
+  /// Model-based marker positions (track/shape_fit.h): the markers are clumps of
+  /// these balls (m, about the centre of mass) touching the camera-side wall
+  /// (y = 0, the bed at y > 0); call after setMarkers.
+  void useShapeFit(const std::vector<geometry::Sphere>& balls);
   /// The camera the tracker works with (e.g. the one recovered by calibration);
   /// call before setMarkers.
   void setCamera(const geometry::Camera& camera) { camera_ = camera; }
@@ -39,6 +46,12 @@ class MarkerTracking {
   struct Result {
     std::vector<track::Track> tracks;               // stitched
     std::vector<track::MarkerVelocity> velocities;  // one per track
+    // With the shape fit, for comparison: the same tracks' velocities at other
+    // depths (the fitted depth per frame, or the fitted pixels on the plane of the
+    // marker centres), one per track each.
+    std::vector<std::pair<std::string, std::vector<track::MarkerVelocity>>> depth_variants;
+    bool shape_fit = false;
+    track::Tracker::ShapeFitCounts shape_fit_counts;
     std::vector<track::StitchJoin> joins;
     std::vector<int> unresolved;                    // track ids (before stitching) left apart
     std::vector<std::pair<int, double>> frames;     // (frame, time s) of every tracked frame
@@ -56,6 +69,7 @@ class MarkerTracking {
   double plane_y_ = 0.0, marker_radius_px_ = 0.0;
   double reference_time_ = std::numeric_limits<double>::quiet_NaN();
   std::unique_ptr<track::Tracker> tracker_;
+  std::optional<track::MarkerModel> shape_model_;  // with the shape fit
   std::vector<std::pair<int, double>> frames_;
   double seconds_ = 0.0;
 };

@@ -64,7 +64,7 @@ nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerT
       {"method",
        "each frame, the truth markers in view (centres projected by the renderer's camera) and the track "
        "points are paired by least total squared distance, at most match_distance_px apart; errors are "
-       "tracked minus truth (world: the tracked pixel on the marker plane minus the true centre)"},
+       "tracked minus truth (world: the tracked centre, fitted or the pixel on the marker plane, minus the true centre)"},
       {"match_distance_px", settings.match_distance_px},
       {"pairs", e.pairs},
       {"pixel_error", pixel},

@@ -190,6 +190,7 @@ class ChuteExperiment final : public Experiment {
     bodies_total_ = bodies_.size();
     calibrateTrackingCamera();
     chooseMarkers(world->particles());
+    if (tracking_ && e_.track_position == "shape") useMarkerShape(world->particles());
     tilt_end_step_ = world->stepCount() + e_.tilt_steps;
     phase_ = Phase::Tilt;
   }
@@ -272,6 +273,41 @@ class ChuteExperiment final : public Experiment {
         markers_.push_back(m);
       }
     }
+  }
+
+  /// The shape fit needs what the lab knows of its markers: one clump shape, the
+  /// same for all, touching the camera-side wall. The first marker's balls about its
+  /// centre of mass give it; markers of different shapes, or placed off the wall
+  /// (marker_y), keep the centroid (shape_fit_skipped_ says why).
+  void useMarkerShape(const sim::ParticleState& p) {
+    if (markers_.empty()) return;
+    if (e_.marker_y > 0) {
+      shape_fit_skipped_ = "experiment.marker_y places the markers off the wall";
+      return;
+    }
+    auto ballsOf = [&](std::uint64_t id) {
+      std::vector<geometry::Sphere> balls;
+      const BodyRef& ref = bodies_.at(id);
+      const Vec3 centre = bodyPosition(p, ref);
+      if (!ref.clump) return std::vector<geometry::Sphere>{{Vec3::Zero(), p.radius[ref.index]}};
+      for (std::uint32_t m = p.clumps.member_begin[ref.index]; m < p.clumps.member_begin[ref.index + 1]; ++m) {
+        const std::uint32_t ball = p.clumps.member_ball[m];
+        balls.push_back({p.position[ball] - centre, p.radius[ball]});
+      }
+      return balls;
+    };
+    const std::vector<geometry::Sphere> shape = ballsOf(markers_.front().id);
+    for (const Marker& m : markers_) {
+      const std::vector<geometry::Sphere> other = ballsOf(m.id);
+      bool same = other.size() == shape.size();
+      for (std::size_t k = 0; same && k < shape.size(); ++k)
+        same = std::abs(other[k].radius - shape[k].radius) <= 1e-9 * shape[k].radius;
+      if (!same) {
+        shape_fit_skipped_ = "the markers are not all the same shape";
+        return;
+      }
+    }
+    tracking_->useShapeFit(shape);
   }
 
   /// Height of the channel above the base at x: under the top plate, else the bed.
@@ -402,6 +438,7 @@ class ChuteExperiment final : public Experiment {
       track_settings_;  // the tracked camera as the renderer has it (takes the calibration photos)
   nlohmann::json calibration_report_;  // recovered against true camera (null: exact camera used)
   std::string tracking_error_;         // why there is no tracking ("" = none or it ran)
+  std::string shape_fit_skipped_;      // why track_position = "shape" fell back to the centroid
   double marker_radius_ = 0.0;         // m
   bool has_top_ = false;
   Vec3 top_point_ = Vec3::Zero(), top_normal_ = Vec3::UnitZ();
@@ -425,6 +462,11 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
   std::vector<bool> used(t.tracks.size(), false);
   double sum2 = 0, sum2_rel = 0, max_abs = 0, max_rel = 0;
   int compared = 0, tracked = 0;
+  struct Errors {
+    double sum2_rel = 0, max_rel = 0;
+    int compared = 0;
+  };
+  std::vector<Errors> variant_errors(t.depth_variants.size());  // the shape fit's other depths
   PlotSeries points{"markers", {}, {}, PlotSeries::Style::Points};
   for (std::size_t k = 0; k < markers_.size(); ++k) {
     const Marker& m = markers_[k];
@@ -447,6 +489,14 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
     if (best >= 0) used[static_cast<std::size_t>(best)] = true;
     out["tracked_velocity_mps"] = orNull(v);
     if (std::isfinite(v)) ++tracked;
+    for (std::size_t d = 0; best >= 0 && d < t.depth_variants.size() && std::isfinite(m.velocity); ++d) {
+      const double other = t.depth_variants[d].second[static_cast<std::size_t>(best)].velocity;
+      if (!std::isfinite(other)) continue;
+      const double rel = (other - m.velocity) / m.velocity;
+      variant_errors[d].sum2_rel += rel * rel;
+      variant_errors[d].max_rel = std::max(variant_errors[d].max_rel, std::abs(rel));
+      ++variant_errors[d].compared;
+    }
     if (std::isfinite(v) && std::isfinite(m.velocity)) {
       const double err = v - m.velocity;
       sum2 += err * err;
@@ -466,12 +516,23 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
       {"markers_compared", compared},
       {"tracking_s", t.seconds},
       {"frames_per_s", t.seconds > 0 ? static_cast<double>(t.frames.size()) / t.seconds : 0.0},
+      {"position", t.shape_fit ? "shape" : "centroid"},
       {"method",
-       "HSV red segmentation, redness-weighted centroids, merged blobs split at the tracks' predictions, "
-       "Hungarian linking with constant-velocity prediction, tracks stitched across gaps; pixel -> world "
-       "on the plane of the marker centres; velocity from 2 mm to measure_distance of travel along the "
-       "base, as the truth"},
+       std::string("HSV red segmentation, redness-weighted centroids, merged blobs split at the tracks' predictions, "
+                   "Hungarian linking with constant-velocity prediction, tracks stitched across gaps; ") +
+           (t.shape_fit ? "position: the marker clump's projected outline fitted to the blob's sub-pixel edges "
+                          "(Levenberg-Marquardt, seeded from the track's previous pose, multi-start at a track's "
+                          "first frame or after a poor fit), its depth from the clump touching the camera wall"
+                        : "position: the centroid, pixel -> world on the plane of the marker centres") +
+           "; velocity from 2 mm to measure_distance of travel along the base, as the truth"},
       {"calibration", calibration_report_}};
+  if (t.shape_fit)
+    s["shape_fit"] = {{"fitted", t.shape_fit_counts.fitted},
+                      {"searched", t.shape_fit_counts.searched},
+                      {"unfitted", t.shape_fit_counts.unfitted},
+                      {"duplicates_withdrawn", t.shape_fit_counts.duplicates}};
+  else if (e_.track_position == "shape")
+    s["shape_fit"] = {{"skipped", shape_fit_skipped_}};
   s["error_report"] =
       trackingErrorReport(*tracking_, t, truth_, track_settings_.camera, markers, out_dir / "tracking_error.png");
   {
@@ -515,6 +576,25 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
         << t.frames.size() << " frames; error against truth: RMS " << s["rms_error_mps"].get<double>()
         << " m/s (" << s["rms_error_pct"].get<double>() << " %), max " << max_abs << " m/s ("
         << 100.0 * max_rel << " %)\n";
+    if (t.shape_fit) {
+      log << "tracking: shape fit on " << t.shape_fit_counts.fitted << " detections ("
+          << t.shape_fit_counts.searched << " searched, " << t.shape_fit_counts.unfitted
+          << " left at the centroid, " << t.shape_fit_counts.duplicates
+          << " withdrawn as another track's duplicate); the same tracks otherwise:";
+      nlohmann::json variants = nlohmann::json::array();
+      for (std::size_t d = 0; d < variant_errors.size(); ++d) {
+        const Errors& e = variant_errors[d];
+        if (e.compared == 0) continue;
+        const double rms = 100.0 * std::sqrt(e.sum2_rel / e.compared);
+        variants.push_back({{"variant", t.depth_variants[d].first},
+                            {"markers_compared", e.compared},
+                            {"rms_error_pct", rms},
+                            {"max_error_pct", 100.0 * e.max_rel}});
+        log << ' ' << t.depth_variants[d].first << " RMS " << rms << " %, max " << 100.0 * e.max_rel << " %;";
+      }
+      log << "\n";
+      s["position_variants"] = variants;
+    }
   } else {
     log << "tracking: no marker was tracked over the whole " << e_.measure_distance * 1e3
         << " mm\n";
@@ -727,6 +807,7 @@ std::shared_ptr<ExperimentSettings> readChuteSettings(TableReader& t,
   e.track_camera =
       t.string("track_camera", camera_names.empty() ? "" : camera_names.front(), camera_names);
   if (!e.track) e.track_camera.clear();
+  e.track_position = t.string("track_position", e.track_position, {"shape", "centroid"});
   return settings;
 }
 

@@ -37,6 +37,9 @@ struct ChuteSettings final : ExperimentSettings {
   double jam_time = 1.0;          // s without any discharge (bodies left) = jammed
   std::string track_camera;       // camera whose frames are tracked (default the first; "" = none)
   bool track = true;              // track the markers in that camera's frames
+  // A marker's image position: "shape" = the projected outline of its clump fitted
+  // to the blob's edges (track/shape_fit.h), "centroid" = the blob's redness-weighted centroid.
+  std::string track_position = "shape";
 };
 
 std::shared_ptr<ExperimentSettings> readChuteSettings(TableReader& table,

@@ -276,6 +276,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.chute", "jam_time", "s", "No discharge for this long while bodies remain = jammed; the run stops."},
       {"experiment.chute", "track", "", "Track the markers in the frames of track_camera."},
       {"experiment.chute", "track_camera", "", "Camera whose frames are tracked.", "a camera name", "the first camera"},
+      {"experiment.chute", "track_position", "", "A marker's position: \"shape\" fits the projected outline of its clump (touching the camera wall, so the depth follows from the fitted orientation) to the blob's sub-pixel edges, seeded from the track's previous pose; \"centroid\" is the blob's redness-weighted centroid on the plane of the marker centres (docs/camera.md)."},
       {"experiment.crusher", "", "", "type = \"crusher\": the cone crusher's run (docs/crusher.md): spheres below discharge_height are product (removed, size and mass in product.csv); ends when the chamber is empty."},
       {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
       {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},

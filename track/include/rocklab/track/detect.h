@@ -31,6 +31,7 @@
 //   5. measure    — centroid weighted by the redness w = max(0, r − max(g, b)) over
 //                   the piece and a one-pixel rim around it (the antialiased edge
 //                   that missed the thresholds), so it is sub-pixel;
+//   5b. edges     — with edge_points: the outline's sub-pixel points (src/edges.cpp);
 //   6. filter     — area within [min_area_px, max_area_px], fill ≥ min_fill.
 // Pixel coordinates follow geometry::Camera: (0, 0) is the centre of the top-left pixel.
 #include <vector>
@@ -44,6 +45,7 @@ struct Detection {
   double area_px = 0;    // px², pixels of the (opened) mask in this marker
   double radius_px = 0;  // px, equivalent radius √(area / π)
   double fill = 0;       // area / area of the smallest enclosing circle [-]: 1 for a disc, ½ for two touching discs
+  std::vector<cv::Point2f> edge_points;  // px, sub-pixel outline (only with DetectorSettings::edge_points)
 };
 
 struct DetectorSettings {
@@ -71,6 +73,10 @@ struct DetectorSettings {
   // Area of one marker [px²]; 0 = the median component area of each frame (needs
   // a frame with mostly single markers; with one component nothing is ever split).
   double expected_area_px = 0.0;
+  // Stage 5b: also give each detection the sub-pixel points of its outline (its
+  // core pixels' steps to the unthresholded rim, placed by the two pixels'
+  // redness), for the model-based position (shape_fit.h). Off: nothing is spent.
+  bool edge_points = false;
 
   /// Throws std::invalid_argument naming the first invalid field ("detector.min_fill ...").
   void validate() const;

@@ -22,10 +22,12 @@
 //                 instead of guessing: it is listed in ambiguousEnds() and its
 //                 detection starts a new track (stitching may join them, stitch.h).
 // A track that missed some frames is re-found like any other (its prediction spans the gap).
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "rocklab/geometry/vec.h"
 #include "rocklab/track/detect.h"
 
 namespace rocklab::track {
@@ -33,7 +35,12 @@ namespace rocklab::track {
 struct TrackPoint {
   int frame = 0;
   double time = 0.0;    // s
-  cv::Point2d pixel;    // px
+  cv::Point2d pixel;    // px, the marker's position: the detection's centroid, or the shape fit's centre
+  cv::Point2d detected = {std::numeric_limits<double>::quiet_NaN(), 0.0};  // px, the detection's centroid
+                        // (the linker predicts from these; NaN = the same as pixel)
+  // m, world: the marker's centre when the shape fit gave it (its depth from the
+  // clump touching the wall); NaN = not fitted (pixel → world on the marker plane).
+  geometry::Vec3 centre = geometry::Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct Track {
@@ -71,8 +78,24 @@ class Linker {
   /// Does not change the linker.
   std::vector<cv::Point2d> predictions(int frame, double time) const;
 
-  /// Every track so far (ended or not), by id.
+  /// Every track so far (ended or not; withdrawn ones with no point left are left
+  /// out), by id.
   std::vector<Track> tracks() const;
+  /// The track each detection of the last add() went to (extended or started), by
+  /// detection index.
+  const std::vector<int>& lastTrackIds() const { return last_track_ids_; }
+  /// The model-based position of a track's point in the last add() (shape_fit.h):
+  /// `pixel` replaces the reported position (the centroid stays for prediction),
+  /// `centre` is the fitted world centre. Throws std::invalid_argument when the
+  /// track has no point in the last frame.
+  void refineLastPoint(int id, cv::Point2d pixel, const geometry::Vec3& centre);
+  /// A track whose point in the last add() repeats another track's marker (the
+  /// shape fit found both on one clump): that point is removed and the track ends;
+  /// a track left without points is gone from tracks(). Throws std::invalid_argument
+  /// when the track has no point in the last frame.
+  void withdraw(int id);
+  /// Points of a track so far.
+  std::size_t pointCount(int id) const { return tracks_.at(static_cast<std::size_t>(id)).points.size(); }
   /// Ids of the tracks that ended at an ambiguous match (step 5), ascending.
   const std::vector<int>& ambiguousEnds() const { return ambiguous_ends_; }
 
@@ -83,6 +106,7 @@ class Linker {
   std::vector<Track> tracks_;  // index = id
   std::vector<int> active_;    // ids of tracks that may still be found
   std::vector<int> ambiguous_ends_;
+  std::vector<int> last_track_ids_;  // per detection of the last frame
   int last_frame_ = 0;
   double last_time_ = 0.0;
   bool started_ = false;

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "rocklab/geometry/camera.h"
+#include "rocklab/track/link.h"
 
 namespace rocklab::track {
 
@@ -14,6 +15,11 @@ namespace rocklab::track {
 /// Empty when the ray is parallel to the plane, meets it behind the camera, or the
 /// pixel lies where the lens distortion cannot be inverted.
 std::optional<geometry::Vec3> pixelToPlane(const geometry::Camera& camera, cv::Point2d pixel,
+                                           const geometry::Vec3& plane_point, const geometry::Vec3& plane_normal);
+
+/// A track point in the world: its fitted centre when the shape fit gave one
+/// (TrackPoint::centre), else its pixel on the plane (pixelToPlane).
+std::optional<geometry::Vec3> pointToWorld(const geometry::Camera& camera, const TrackPoint& point,
                                            const geometry::Vec3& plane_point, const geometry::Vec3& plane_normal);
 
 }  // namespace rocklab::track

@@ -38,7 +38,8 @@ MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world, co
                                     const geometry::Vec3& direction, double distance, double onset,
                                     double reference_time = std::numeric_limits<double>::quiet_NaN());
 
-/// The same for a track: each pixel is taken to the plane (pixelToPlane); points
+/// The same for a track: each point is taken to the world (pointToWorld: its fitted
+/// centre, else its pixel on the plane); points
 /// whose ray misses the plane are skipped (none left: incomplete, every field NaN).
 /// track_id is the track's.
 MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera, const geometry::Vec3& plane_point,
