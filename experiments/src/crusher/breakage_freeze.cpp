@@ -72,14 +72,12 @@ double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_
   return e;
 }
 
-/// The largest overlap of any of `movers` with a wall, over its radius. The walls
+/// The largest overlap of any ball flagged in `is_mover` with a wall, over its radius. The walls
 /// are held, so a fragment pressed into one by its neighbours can stay there; handed
 /// back, that overlap would be at the wall's stiffness (1e13 N/m in series with the
 /// ball's) and break it again at the next check.
-double wallOverlapFraction(const sim::World& world, const std::vector<std::uint32_t>& movers) {
+double wallOverlapFraction(const sim::World& world, const std::vector<bool>& is_mover) {
   const sim::ParticleState& p = world.particles();
-  std::vector<bool> is_mover(p.size(), false);
-  for (const std::uint32_t m : movers) is_mover[m] = true;
   const sim::TouchingContacts t = world.touchingContacts();
   double worst = 0;
   for (std::size_t k = 0; k < t.walls.size(); ++k)
@@ -182,6 +180,8 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
   if (result.stall_window_cycles > 0)
     check = std::clamp<std::uint64_t>(result.stall_window_cycles / 4, 1, check);
   OverlapStall stall(result.stall_window_cycles, s.stall_tolerance);
+  std::vector<bool> is_fragment(world.particles().size(), false);  // for the wall overlaps, every check
+  for (const std::uint32_t f : fragments) is_fragment[f] = true;
   for (;;) {
     if (result.cycles % check == 0) {
       if (stopRequested()) {
@@ -195,7 +195,7 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
         continue;
       }
       result.max_overlap = std::max(fragmentOverlaps(m, world.particles(), fragments).max_fraction,
-                                    wallOverlapFraction(world, fragments));
+                                    wallOverlapFraction(world, is_fragment));
       result.kinetic_energy = kineticEnergy(world.particles(), moving);
       const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;
       const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample

@@ -96,7 +96,7 @@ const char* freezeScopeName(FreezeScope scope);
 
 struct FreezeSettings {
   FreezeScope scope = FreezeScope::Local;
-  double density = 3e9;           // kg/m^3, every ball's during the freeze ("local": the fragments')
+  double density = 3e9;           // kg/m^3, every ball's during the freeze ("local": the movers')
   double held_density = 1e30;     // kg/m^3, the held neighbours' ("local" only)
   double local_reach = 1.0;       // largest-fragment diameters, surface to surface ("local" only)
   double stiffness = 1e3;         // N/m, the fragments' kn and ks during the freeze
@@ -125,7 +125,7 @@ struct FreezeResult {
   std::uint64_t stall_window_cycles = 0;  // the stall rule's window in cycles (0: off)
   double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
   double max_overlap = 0.0;        // largest fragment overlap / smaller radius (walls: / its radius) at the end
-  double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the fragments')
+  double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the movers')
   std::size_t balls = 0;           // balls in the freeze World (the last run of it)
   int reach_widenings = 0;         // "local": runs repeated with the reach doubled
   std::size_t moved_neighbours = 0;  // "local": neighbours that moved with the fragments (not loaded)
