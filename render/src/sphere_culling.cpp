@@ -4,20 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "bands.h"
+
 namespace rocklab::render::detail {
 
 namespace {
-
-// Image of a sphere around its projected centre (u, v): every pixel it touches
-// (soft edge included) lies within `outer`; every pixel within `inner` is fully
-// covered. With d = |c|, α = asin(r/d) and θ the angle of c off the optical axis,
-// the image is an ellipse with radial ends at f tan(θ ± α) and semi-axes ≥ f sin α;
-// the projected centre sits δ = f ((tan(θ+α) + tan(θ−α))/2 − tan θ) outward of the
-// ellipse centre. Half a pixel more (less) for the antialiased edge ramp.
-struct Footprint {
-  double u, v, inner, outer;
-  bool valid;
-};
 
 Footprint footprint(const CameraSphere& s, const Canvas& canvas) {
   const double x = s.x, y = s.y, z = s.z, r = s.radius;
@@ -32,50 +23,79 @@ Footprint footprint(const CameraSphere& s, const Canvas& canvas) {
           fMax * (tp - t) + safety, true};
 }
 
-}  // namespace
-
-const std::vector<std::uint8_t>& SphereCuller::cull(const std::vector<CameraSphere>& spheres,
-                                                    const std::vector<std::uint32_t>& order, const Canvas& canvas) {
-  const int w = canvas.width, h = canvas.height;
-  marked_.assign(static_cast<std::size_t>(w) * h, std::numeric_limits<float>::infinity());
-  visible_.assign(spheres.size(), 1);
+// One band of rows [row0, row1): every sphere in order, tested and marked on this
+// band's pixels only. Bands share no pixels, so they run at once; the union of the
+// bands' verdicts equals the whole-canvas cull exactly: marking a sphere that one
+// band finds hidden changes nothing there (its pixels already hold nearer depths).
+void cullBand(const std::vector<CameraSphere>& spheres, const std::vector<std::uint32_t>& order,
+              const std::vector<Footprint>& footprints, int w, int row0, int row1, float* marked,
+              std::uint8_t* visible) {
+  std::fill(marked + static_cast<std::size_t>(row0) * w, marked + static_cast<std::size_t>(row1) * w,
+            std::numeric_limits<float>::infinity());
   for (std::uint32_t i : order) {
     const CameraSphere& s = spheres[i];
-    const Footprint f = footprint(s, canvas);
-    if (!f.valid) continue;
-    // Hidden if every pixel centre within `outer` is marked by something wholly in front.
+    const Footprint& f = footprints[i];
+    if (!f.valid) {
+      visible[i] = 1;
+      continue;
+    }
+    // Hidden (in this band) if every pixel centre within `outer` is marked by something wholly in front.
     const float nearest = s.z - s.radius;
-    const int j0 = std::max(0, static_cast<int>(std::ceil(f.v - f.outer)));
-    const int j1 = std::min(h - 1, static_cast<int>(std::floor(f.v + f.outer)));
+    const int j0 = std::max(row0, static_cast<int>(std::ceil(f.v - f.outer)));
+    const int j1 = std::min(row1 - 1, static_cast<int>(std::floor(f.v + f.outer)));
     bool hidden = true;
     for (int j = j0; j <= j1 && hidden; ++j) {
       const double dy = j - f.v, half = std::sqrt(std::max(0.0, f.outer * f.outer - dy * dy));
       const int i0 = std::max(0, static_cast<int>(std::ceil(f.u - half)));
       const int i1 = std::min(w - 1, static_cast<int>(std::floor(f.u + half)));
-      const float* row = marked_.data() + static_cast<std::size_t>(j) * w;
-      for (int k = i0; k <= i1; ++k)
-        if (!(row[k] < nearest)) {
-          hidden = false;
-          break;
-        }
+      // Branch-free within the row, so the compiler vectorises it: a hidden sphere scans
+      // its whole footprint, and those are the costly ones.
+      const float* row = marked + static_cast<std::size_t>(j) * w;
+      int covered = 1;
+      for (int k = i0; k <= i1; ++k) covered &= static_cast<int>(row[k] < nearest);
+      hidden = covered != 0;
     }
-    if (hidden) {
-      visible_[i] = 0;
-      continue;
-    }
+    if (hidden) continue;
+    visible[i] = 1;
     // Mark the pixels it surely covers with its farthest depth.
     if (f.inner <= 0.0) continue;
     const float farthest = s.z + s.radius;
-    const int m0 = std::max(0, static_cast<int>(std::ceil(f.v - f.inner)));
-    const int m1 = std::min(h - 1, static_cast<int>(std::floor(f.v + f.inner)));
+    const int m0 = std::max(row0, static_cast<int>(std::ceil(f.v - f.inner)));
+    const int m1 = std::min(row1 - 1, static_cast<int>(std::floor(f.v + f.inner)));
     for (int j = m0; j <= m1; ++j) {
       const double dy = j - f.v, half = std::sqrt(std::max(0.0, f.inner * f.inner - dy * dy));
       const int i0 = std::max(0, static_cast<int>(std::ceil(f.u - half)));
       const int i1 = std::min(w - 1, static_cast<int>(std::floor(f.u + half)));
-      float* row = marked_.data() + static_cast<std::size_t>(j) * w;
+      float* row = marked + static_cast<std::size_t>(j) * w;
       for (int k = i0; k <= i1; ++k) row[k] = std::min(row[k], farthest);
     }
   }
+}
+
+}  // namespace
+
+SphereCuller::SphereCuller(int threads) : threads_(bandCount(threads)) {}
+
+const std::vector<std::uint8_t>& SphereCuller::cull(const std::vector<CameraSphere>& spheres,
+                                                    const std::vector<std::uint32_t>& order, const Canvas& canvas) {
+  const int w = canvas.width, h = canvas.height;
+  // Bands of at least 32 rows: below that a thread costs more than it saves.
+  const int bands = std::max(1, std::min(threads_, h / 32));
+  marked_.resize(static_cast<std::size_t>(w) * h);
+  footprints_.resize(spheres.size());
+  bandVisible_.resize(static_cast<std::size_t>(bands));
+  for (auto& v : bandVisible_) v.assign(spheres.size(), 0);
+  runBands(bands, [&](int b) {
+    const std::size_t n = spheres.size(), first = n * b / bands, last = n * (b + 1) / bands;
+    for (std::size_t i = first; i < last; ++i) footprints_[i] = footprint(spheres[i], canvas);
+  });
+  runBands(bands, [&](int b) {
+    cullBand(spheres, order, footprints_, w, h * b / bands, h * (b + 1) / bands, marked_.data(),
+             bandVisible_[static_cast<std::size_t>(b)].data());
+  });
+  visible_ = bandVisible_[0];
+  for (std::size_t b = 1; b < bandVisible_.size(); ++b)
+    for (std::size_t i = 0; i < visible_.size(); ++i) visible_[i] |= bandVisible_[b][i];
   return visible_;
 }
 

@@ -23,14 +23,31 @@ struct CameraSphere {
   float radius;   // m
 };
 
+// Image of a sphere around its projected centre (u, v): every pixel it touches
+// (soft edge included) lies within `outer`; every pixel within `inner` is fully
+// covered. With d = |c|, α = asin(r/d) and θ the angle of c off the optical axis,
+// the image is an ellipse with radial ends at f tan(θ ± α) and semi-axes ≥ f sin α;
+// the projected centre sits δ = f ((tan(θ+α) + tan(θ−α))/2 − tan θ) outward of the
+// ellipse centre. Half a pixel more (less) for the antialiased edge ramp.
+struct Footprint {  // pixels
+  double u, v, inner, outer;
+  bool valid;
+};
+
 class SphereCuller {
  public:
+  /// `threads` bands of rows culled at once (0: the machine's cores, at most 8); the
+  /// result does not depend on it.
+  explicit SphereCuller(int threads = 0);
   /// `order` lists indices into `spheres` near to far. Returns visible[i] for each sphere.
   const std::vector<std::uint8_t>& cull(const std::vector<CameraSphere>& spheres, const std::vector<std::uint32_t>& order,
                                         const Canvas& canvas);
 
  private:
+  int threads_;
   std::vector<float> marked_;  // per canvas pixel: depth behind which everything is hidden (m), +inf unmarked
+  std::vector<Footprint> footprints_;
+  std::vector<std::vector<std::uint8_t>> bandVisible_;  // per band of rows: visible there
   std::vector<std::uint8_t> visible_;
 };
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstddef>
 
+#include "bands.h"
+
 namespace rocklab::render::detail {
 
 namespace {
@@ -73,24 +75,47 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
   const double yt = (-2.5 - canvas.cy) / canvas.fy, yb = (canvas.height + 1.5 - canvas.cy) / canvas.fy;
   const std::array<geometry::Vec3, 4> planes{geometry::Vec3(1, 0, -xl).normalized(), geometry::Vec3(-1, 0, xr).normalized(),
                                              geometry::Vec3(0, 1, -yt).normalized(), geometry::Vec3(0, -1, yb).normalized()};
+  // Near to far for the occlusion test (then drawn far to near); ties by list index, so
+  // the order is total and sorting the chunks, then merging them, gives the one order.
+  const auto nearFirst = [](const Key& a, const Key& b) {
+    return a.power != b.power ? a.power < b.power : a.index < b.index;
+  };
+  // Chunks of the list on their own threads, joined in list order: the same staging as one pass.
+  const std::size_t n = spheres.size();
+  const int chunks = n >= 2000 ? bandCount(0) : 1;
+  chunks_.resize(static_cast<std::size_t>(chunks));
+  runBands(chunks, [&](int b) {
+    Staging& out = chunks_[static_cast<std::size_t>(b)];
+    out.keys.clear();
+    out.staged.clear();
+    out.colours.clear();
+    for (std::size_t i = n * b / chunks; i < n * (b + 1) / chunks; ++i) {
+      const SphereInstance& s = spheres[i];
+      const geometry::Vec3 c = rotation * (s.centre + dt * s.velocity) + translation;
+      const double r = s.radius;
+      // Not drawn: crossing the near plane (the impostor needs the eye outside), wholly beyond far, outside the sides.
+      if (c.z() - r < nearClip || c.z() - r > farClip) continue;
+      bool outside = false;
+      for (const auto& plane : planes) outside = outside || plane.dot(c) < -r;
+      if (outside) continue;
+      out.keys.push_back({c.squaredNorm() - r * r, static_cast<std::uint32_t>(out.staged.size())});
+      out.staged.push_back({static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
+                            static_cast<float>(r)});
+      out.colours.push_back({toByte(s.colour.r), toByte(s.colour.g), toByte(s.colour.b), 255});
+    }
+    std::sort(out.keys.begin(), out.keys.end(), nearFirst);
+  });
   keys_.clear();
   staged_.clear();
   colours_.clear();
-  for (const SphereInstance& s : spheres) {
-    const geometry::Vec3 c = rotation * (s.centre + dt * s.velocity) + translation;
-    const double r = s.radius;
-    // Not drawn: crossing the near plane (the impostor needs the eye outside), wholly beyond far, outside the sides.
-    if (c.z() - r < nearClip || c.z() - r > farClip) continue;
-    bool outside = false;
-    for (const auto& n : planes) outside = outside || n.dot(c) < -r;
-    if (outside) continue;
-    keys_.push_back({c.squaredNorm() - r * r, static_cast<std::uint32_t>(staged_.size())});
-    staged_.push_back({static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()), static_cast<float>(r)});
-    colours_.push_back({toByte(s.colour.r), toByte(s.colour.g), toByte(s.colour.b), 255});
+  for (const Staging& chunk : chunks_) {
+    const auto offset = static_cast<std::uint32_t>(staged_.size());
+    const auto sorted = static_cast<std::ptrdiff_t>(keys_.size());  // the keys so far, in order
+    for (const Key& k : chunk.keys) keys_.push_back({k.power, k.index + offset});
+    std::inplace_merge(keys_.begin(), keys_.begin() + sorted, keys_.end(), nearFirst);
+    staged_.insert(staged_.end(), chunk.staged.begin(), chunk.staged.end());
+    colours_.insert(colours_.end(), chunk.colours.begin(), chunk.colours.end());
   }
-  // Near to far for the occlusion test; then drawn far to near.
-  std::sort(keys_.begin(), keys_.end(),
-            [](const Key& a, const Key& b) { return a.power != b.power ? a.power < b.power : a.index < b.index; });
   order_.resize(keys_.size());
   for (std::size_t k = 0; k < keys_.size(); ++k) order_[k] = keys_[k].index;
   const std::vector<std::uint8_t>& visible = culler_.cull(staged_, order_, canvas);

@@ -46,6 +46,12 @@ class SpherePass {
   GLint uCanvasSize_, uAsQuads_, uIntrinsics_, uDepthMap_, uLighting_, uGain_;
   GLuint pointVao_ = 0, quadVao_ = 0, vbo_ = 0;
   float maxPointSize_ = 1.0f;
+  struct Staging {  // one chunk of the sphere list, staged on its own thread
+    std::vector<Key> keys;
+    std::vector<CameraSphere> staged;
+    std::vector<std::array<std::uint8_t, 4>> colours;
+  };
+  std::vector<Staging> chunks_;
   std::vector<Key> keys_;
   std::vector<CameraSphere> staged_;
   std::vector<std::array<std::uint8_t, 4>> colours_;

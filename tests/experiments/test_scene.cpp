@@ -1,6 +1,7 @@
 // Scene files: every class of bad input gives one message naming file, line,
 // key, value and what is allowed; built-in scenes load.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -275,6 +276,47 @@ region_max = [0.2, 0.2, 0.2]
   CHECK_THROWS_WITH(loadSceneText(text, "clumps.toml", {"particles.1.file=\"nope.txt\""},
                                   std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes"),
                     Contains("particles.1.file"));
+}
+
+TEST_CASE("a random source takes its sphere sizes from a product file", "[scene]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "rocklab-diameters";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream product(dir / "product.csv");
+    product << "id,time_s,diameter_mm,mass_kg,residence_s\n1,0.5,12,0.002,0.4\n2,0.6,8.5,0.001,0.3\n3,0.7,20,0.01,nan\n";
+    std::ofstream bad(dir / "bad.csv");
+    bad << "id,diameter_mm\n1,12\n2,-3\n";
+    std::ofstream none(dir / "none.csv");
+    none << "id,size\n1,12\n";
+  }
+  const std::string text = R"(
+[scene]
+name = "from-product"
+end_time = 0.1
+[materials.rock]
+density = 2730.0
+[[particles]]
+type = "random"
+material = "rock"
+diameters_file = "product.csv"
+region_min = [0.0, 0.0, 0.0]
+region_max = [0.2, 0.2, 0.1]
+)";
+  const Scene s = loadSceneText(text, "product.toml", {}, dir.string());
+  REQUIRE(s.spheres.size() == 3);
+  std::vector<double> radii;
+  for (const auto& b : s.spheres) radii.push_back(b.radius);
+  std::sort(radii.begin(), radii.end());
+  CHECK(radii[0] == Approx(0.00425));
+  CHECK(radii[1] == Approx(0.006));
+  CHECK(radii[2] == Approx(0.010));
+  // A bad row names the file, the line and the value; a count beside the file is refused.
+  CHECK_THROWS_WITH(loadSceneText(text, "product.toml", {"particles.0.diameters_file=\"bad.csv\""}, dir.string()),
+                    Contains("bad.csv line 3") && Contains("'-3'"));
+  CHECK_THROWS_WITH(loadSceneText(text, "product.toml", {"particles.0.diameters_file=\"none.csv\""}, dir.string()),
+                    Contains("no diameter_mm or diameter_m column"));
+  CHECK_THROWS_WITH(loadSceneText(text, "product.toml", {"particles.0.count=5"}, dir.string()),
+                    Contains("diameters_file gives the spheres"));
 }
 
 TEST_CASE("camera keys are checked and a scene without cameras has none", "[scene]") {

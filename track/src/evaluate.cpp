@@ -58,6 +58,7 @@ TrackingEvaluation evaluateTracks(const std::vector<Track>& tracks, const std::v
   for (std::size_t m = 0; m < truth.size(); ++m) out.markers[m].truth_id = truth[m].id;
   Moments u, v;
   std::vector<Moments> world(axes.size());
+  std::vector<Moments> marker_distance(truth.size());  // per marker: |tracked − truth| in px
   std::vector<int> last_track(truth.size(), -1);    // track a marker was last paired with
   std::vector<int> last_marker(tracks.size(), -1);  // marker a track was last paired with
   const double gate2 = settings.match_distance_px * settings.match_distance_px;
@@ -95,15 +96,19 @@ TrackingEvaluation evaluateTracks(const std::vector<Track>& tracks, const std::v
       last_marker[t] = static_cast<int>(m);
       u.add(track_point->pixel.x - truth_point->pixel.x);
       v.add(track_point->pixel.y - truth_point->pixel.y);
+      marker_distance[m].add(cv::norm(track_point->pixel - truth_point->pixel));
       ++out.subpixel_u[static_cast<std::size_t>(subpixelBin(track_point->pixel.x, settings.subpixel_bins))];
       ++out.subpixel_v[static_cast<std::size_t>(subpixelBin(track_point->pixel.y, settings.subpixel_bins))];
-      if (const auto x = pointToWorld(camera, *track_point, plane_point, plane_normal))
+      const std::optional<geometry::Vec3> x = pointToWorld(camera, *track_point, plane_point, plane_normal);
+      if (x)
         for (std::size_t a = 0; a < axes.size(); ++a) world[a].add((*x - truth_point->world).dot(axes[a].direction));
+      out.paired.push_back({frame, m, track_id, truth_point->pixel, track_point->pixel, truth_point->world, x});
     }
   }
   out.pixel_error = {u.error("u"), v.error("v")};
   for (std::size_t a = 0; a < axes.size(); ++a) out.world_error.push_back(world[a].error(axes[a].name));
   int in_view = 0, found_frames = 0;
+  for (std::size_t m = 0; m < out.markers.size(); ++m) out.markers[m].rms_px = marker_distance[m].error("").rms;
   for (MarkerScore& s : out.markers) {
     s.fraction_found = s.frames_in_view ? static_cast<double>(s.frames_found) / s.frames_in_view : 0.0;
     out.track_changes += s.track_changes;

@@ -104,6 +104,16 @@ std::filesystem::path plotDataPath(const std::filesystem::path& png) {
   return csv.replace_extension(".plot.csv");
 }
 
+PlotSpec sieveChart(std::string title) {
+  PlotSpec spec;
+  spec.title = std::move(title);
+  spec.x_label = "sieve size (mm)";
+  spec.y_label = "cumulative mass passing (%)";
+  spec.log_x = true;
+  spec.y_range = std::pair{0.0, 100.0};
+  return spec;
+}
+
 void writePlot(const PlotSpec& spec, const std::filesystem::path& png) {
   if (spec.width < 200 || spec.height < 150)
     throw std::invalid_argument("plot '" + png.string() + "': size must be at least 200 x 150 pixels");

@@ -40,6 +40,10 @@ struct PlotSpec {
   int width = 900, height = 600;  // pixels; at least 200 × 150
 };
 
+/// A sieve chart's frame: cumulative mass passing (%, 0-100) against the sieve size
+/// (mm, log axis), as product curves are drawn.
+PlotSpec sieveChart(std::string title);
+
 /// Draws the plot: `png`, the SVG beside it (same stem; with gnuplot only) and the
 /// plotted data as plotDataPath(png), each written atomically ("<file>.partial", then
 /// rename), so a half-written plot never replaces a good one. Throws std::runtime_error

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "analysis/plot.h"
+#include "rocklab/track/export.h"
 
 namespace rocklab::experiments {
 
@@ -36,13 +37,16 @@ std::vector<track::TruthMarker> MarkerTruth::atFrames(const std::vector<std::pai
 
 nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerTracking::Result& result,
                                    const MarkerTruth& truth, const geometry::Camera& true_camera,
-                                   nlohmann::json& markers, const std::filesystem::path& png) {
+                                   nlohmann::json& markers, const std::filesystem::path& png,
+                                   const std::filesystem::path& pairs_csv) {
   track::EvaluationSettings settings;
   settings.match_distance_px = tracking.markerRadiusPx();
   settings.image_size = {true_camera.width, true_camera.height};
+  const std::vector<track::TruthMarker> truth_at_frames = truth.atFrames(result.frames, true_camera);
   const track::TrackingEvaluation e = track::evaluateTracks(
-      result.tracks, truth.atFrames(result.frames, true_camera), tracking.camera(), tracking.planePoint(),
-      geometry::Vec3::UnitY(), {{"x", geometry::Vec3::UnitX()}, {"z", geometry::Vec3::UnitZ()}}, settings);
+      result.tracks, truth_at_frames, tracking.camera(), tracking.planePoint(), geometry::Vec3::UnitY(),
+      {{"x", geometry::Vec3::UnitX()}, {"z", geometry::Vec3::UnitZ()}}, settings);
+  track::writePairedCsv(pairs_csv, e, truth_at_frames);
 
   nlohmann::json pixel, world;
   for (const track::AxisError& a : e.pixel_error) pixel[a.axis] = {{"bias_px", a.bias}, {"rms_px", a.rms}};
@@ -54,6 +58,7 @@ nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerT
   for (std::size_t m = 0; m < e.markers.size() && m < markers.size(); ++m) {
     markers[m]["fraction_found"] = e.markers[m].fraction_found;
     markers[m]["track_ids_in_frames"] = e.markers[m].track_ids;
+    markers[m]["pixel_rms_px"] = e.markers[m].rms_px;
     per_marker.push_back(e.markers[m].fraction_found);
   }
   nlohmann::json joins = nlohmann::json::array();

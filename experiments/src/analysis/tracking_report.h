@@ -31,10 +31,12 @@ class MarkerTruth {
 };
 
 /// Evaluates the tracks (match distance: one marker radius in px; world axes x and
-/// z, the plane of the film), writes `png` and returns the JSON block; per-marker
-/// figures go into `markers[k]` (fraction_found, track_ids).
+/// z, the plane of the film), writes `png` and every truth-track pair of every frame
+/// to `pairs_csv` (track/export.h), and returns the JSON block; per-marker figures go
+/// into `markers[k]` (fraction_found, track_ids_in_frames, pixel_rms_px).
 nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerTracking::Result& result,
                                    const MarkerTruth& truth, const geometry::Camera& true_camera,
-                                   nlohmann::json& markers, const std::filesystem::path& png);
+                                   nlohmann::json& markers, const std::filesystem::path& png,
+                                   const std::filesystem::path& pairs_csv);
 
 }  // namespace rocklab::experiments

@@ -22,6 +22,9 @@ render::RenderOptions renderOptionsFor(const CameraSettings& c) {
   render::RenderOptions o;
   o.motionBlur = c.motion_blur;
   o.noiseSigma = c.noise_sigma;
+  o.ambient = static_cast<float>(c.ambient);
+  o.diffuse = static_cast<float>(c.diffuse);
+  o.specular = static_cast<float>(c.specular);
   return o;
 }
 

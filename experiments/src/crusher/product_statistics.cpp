@@ -27,6 +27,19 @@ std::optional<double> sizeAtPassing(std::span<const ProductBall> balls, double f
   return sorted.back().diameter;  // fraction 1 up to round-off
 }
 
+std::vector<double> massPassing(std::span<const ProductBall> balls, const std::vector<double>& sieves_mm) {
+  double total = 0;
+  for (const ProductBall& b : balls) total += b.mass;
+  std::vector<double> passing;
+  for (const double sieve : sieves_mm) {
+    double finer = 0;
+    for (const ProductBall& b : balls)
+      if (b.diameter * 1e3 < sieve) finer += b.mass;
+    passing.push_back(total > 0 ? finer / total : 0.0);
+  }
+  return passing;
+}
+
 void ChamberEntries::record(std::span<const std::uint64_t> ids, std::span<const double> heights, double time) {
   for (std::size_t i = 0; i < ids.size(); ++i)
     if (heights[i] < top_) entered_.try_emplace(ids[i], time);

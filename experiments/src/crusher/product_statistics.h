@@ -25,6 +25,10 @@ struct ProductBall {
 /// the smallest diameter below its own fraction. Empty without balls.
 std::optional<double> sizeAtPassing(std::span<const ProductBall> balls, double fraction);
 
+/// Mass fraction of `balls` finer than each of `sieves_mm` (mm), as a sieve chart's
+/// cumulative passing; 0 at every sieve without balls.
+std::vector<double> massPassing(std::span<const ProductBall> balls, const std::vector<double>& sieves_mm);
+
 /// When each ball entered the chamber (its centre first below the chamber's top);
 /// a fragment keeps its parent's entry, so the residence of a product fragment
 /// runs from when its feed ball entered, however often it broke on the way.

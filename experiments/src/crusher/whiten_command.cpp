@@ -115,12 +115,7 @@ int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostr
     const std::filesystem::path dir = o.out_dir.empty() ? o.run_dir : o.out_dir;
     std::filesystem::create_directories(dir);
     detail::writeAtomically(dir / "whiten.json", result.dump(2) + "\n");
-    PlotSpec spec;
-    spec.title = "Whiten's model against the DEM product";
-    spec.x_label = "sieve size (mm)";
-    spec.y_label = "cumulative mass passing (%)";
-    spec.log_x = true;
-    spec.y_range = std::pair{0.0, 100.0};
+    PlotSpec spec = sieveChart("Whiten's model against the DEM product");
     PlotSeries dem{"DEM product", sieves, {}, PlotSeries::Style::LinePoints};
     PlotSeries model{"Whiten (k1 " + std::to_string(*k1).substr(0, 5) + ", k2 " + std::to_string(*k2).substr(0, 5) + " mm)",
                      sieves, {}, PlotSeries::Style::LinePoints};

@@ -534,7 +534,8 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
   else if (e_.track_position == "shape")
     s["shape_fit"] = {{"skipped", shape_fit_skipped_}};
   s["error_report"] =
-      trackingErrorReport(*tracking_, t, truth_, track_settings_.camera, markers, out_dir / "tracking_error.png");
+      trackingErrorReport(*tracking_, t, truth_, track_settings_.camera, markers, out_dir / "tracking_error.png",
+                          out_dir / "tracking_pairs.csv");
   {
     const nlohmann::json& er = s["error_report"];
     log << std::defaultfloat << std::setprecision(3) << "tracking error per frame (" << er["pairs"].get<int>()

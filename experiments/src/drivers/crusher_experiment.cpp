@@ -193,15 +193,7 @@ class CrusherRunExperiment final : public Experiment {
 
   /// Mass fraction of `balls` finer than each sieve (0 for no balls).
   std::vector<double> passingOf(const std::vector<ProductBall>& balls) const {
-    const double total = massOf(balls);
-    std::vector<double> passing;
-    for (const double sieve : e_.sieves_mm) {
-      double finer = 0;
-      for (const ProductBall& b : balls)
-        if (b.diameter * 1e3 < sieve) finer += b.mass;
-      passing.push_back(total > 0 ? finer / total : 0.0);
-    }
-    return passing;
+    return crusher::massPassing(balls, e_.sieves_mm);
   }
 
   /// product_size.png: cumulative mass percent passing against the sieve size (log
@@ -209,12 +201,7 @@ class CrusherRunExperiment final : public Experiment {
   void writeProductCurves(const std::vector<double>& product, const std::vector<double>& feed,
                           const std::vector<double>& whiten, const std::filesystem::path& out_dir,
                           std::ostream& log) const {
-    PlotSpec spec;
-    spec.title = "Product size distribution (" + std::to_string(product_.size()) + " balls discharged)";
-    spec.x_label = "sieve size (mm)";
-    spec.y_label = "cumulative mass passing (%)";
-    spec.log_x = true;
-    spec.y_range = std::pair{0.0, 100.0};
+    PlotSpec spec = sieveChart("Product size distribution (" + std::to_string(product_.size()) + " balls discharged)");
     PlotSeries f{"feed", e_.sieves_mm, {}, PlotSeries::Style::LinePoints};
     PlotSeries p{"product", product_.empty() ? std::vector<double>{} : e_.sieves_mm, {}, PlotSeries::Style::LinePoints};
     for (const double v : feed) f.y.push_back(100 * v);

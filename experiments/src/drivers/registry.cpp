@@ -4,6 +4,7 @@
 #include "drivers/crusher_experiment.h"
 #include "drivers/drop_experiment.h"
 #include "drivers/heap_experiment.h"
+#include "drivers/product_photo_experiment.h"
 #include "drivers/zwick_experiment.h"
 
 namespace rocklab::experiments {
@@ -15,6 +16,7 @@ const std::vector<ExperimentDriver>& experimentDrivers() {
       {"chute", readChuteSettings, makeChuteExperiment},
       {"zwick", readZwickSettings, makeZwickExperiment},
       {"crusher", readCrusherRunSettings, makeCrusherRunExperiment},
+      {"product_photo", readProductPhotoSettings, makeProductPhotoExperiment},
   };
   return drivers;
 }

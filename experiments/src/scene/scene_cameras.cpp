@@ -81,6 +81,9 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     c.motion_blur = t.boolean("motion_blur", c.motion_blur);
     c.noise_sigma = t.number("noise_sigma", c.noise_sigma, Range::closed(0, 100));
     c.light_gain = t.number("light_gain", c.light_gain, Range::closed(0, 10));
+    c.ambient = t.number("ambient", c.ambient, Range::closed(0, 2));
+    c.diffuse = t.number("diffuse", c.diffuse, Range::closed(0, 2));
+    c.specular = t.number("specular", c.specular, Range::closed(0, 2));
     c.colour_by = t.string("colour_by", "material", {"material", "fragment"}) == "fragment"
                       ? ColourBy::Fragment
                       : ColourBy::Material;

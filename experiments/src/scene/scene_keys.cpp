@@ -162,6 +162,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"particles", "radius", "m", "Sphere radius (lattice, list; random: or radius_min/radius_max); (agglomerate hcp) sphere radius; (agglomerate dense) r_max, the loose pack's radius.", nullptr, "required (see text)"},
       {"particles", "radius_min", "m", "(random) Smallest radius; radii uniform in [radius_min, radius_max]."},
       {"particles", "radius_max", "m", "(random) Largest radius."},
+      {"particles", "diameters_file", "", "(random) Spheres of these sizes instead of radius or radius_min/radius_max and count: a CSV, relative to the scene, whose first line names a diameter_mm (or diameter_m) column, one sphere a row (a crusher run's product.csv as it is).", nullptr, "none: radius or radius_min/radius_max and count"},
       {"particles", "lattice", "", "(lattice) Simple, body-centred or face-centred cubic."},
       {"particles", "cell", "m", "(lattice) Cell size."},
       {"particles", "offset", "m", "(lattice) Offset of the first point from the corner."},
@@ -240,10 +241,13 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"cameras", "motion_blur", "", "Average sub-frames over the exposure (needs exposure > 0)."},
       {"cameras", "noise_sigma", "", "Gaussian image noise, in grey levels."},
       {"cameras", "light_gain", "", "Brightness factor."},
+      {"cameras", "ambient", "", "Light from all sides, as a fraction of a material's colour (a sizing station's dome light: high ambient, low diffuse)."},
+      {"cameras", "diffuse", "", "The lamp at the camera: diffuse fraction of a material's colour (a sphere darkens towards its outline)."},
+      {"cameras", "specular", "", "The lamp's white highlight (Blinn-Phong)."},
 
       // --- [experiment]
       {"experiment", "", "", "The experiment type and the keys every type has; the other keys depend on the type (tables below)."},
-      {"experiment", "type", "", "The driver: drop, heap, chute (also the zoned chute) or zwick."},
+      {"experiment", "type", "", "The driver: drop, heap, chute (also the zoned chute), zwick, crusher or product_photo."},
       {"experiment", "sample_interval", "s", "Time between the driver's samples (the lab filmed at 500 frames/s)."},
       {"experiment", "check_interval", "", "Renamed: use sample_interval (s); a scene that still has it is refused with that message.", "none", "none"},
       {"experiment.drop", "", "", "type = \"drop\": one body dropped on a wall; restitution from the normal velocity before and after the impact. No keys of its own."},
@@ -277,6 +281,14 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.chute", "track", "", "Track the markers in the frames of track_camera."},
       {"experiment.chute", "track_camera", "", "Camera whose frames are tracked.", "a camera name", "the first camera"},
       {"experiment.chute", "track_position", "", "A marker's position: \"shape\" fits the projected outline of its clump (touching the camera wall, so the depth follows from the fitted orientation) to the blob's sub-pixel edges, seeded from the track's previous pose; \"centroid\" is the blob's redness-weighted centroid on the plane of the marker centres (docs/camera.md)."},
+      {"experiment.product_photo", "", "", "type = \"product_photo\": particles settle on a tray; the first camera photographs them from above and their sizes are measured from the photograph (docs/crusher.md, product size from images) against the settled balls' true diameters."},
+      {"experiment.product_photo", "settle_speed", "m/s", "At rest when no body is faster; the photograph is the camera's last frame before."},
+      {"experiment.product_photo", "settle_min_time", "s", "Not at rest before this time."},
+      {"experiment.product_photo", "settle_max_time", "s", "Give up waiting at this time (reported, not hidden)."},
+      {"experiment.product_photo", "surface_z", "m", "Height of the tray the particles lie on (its normal is +z)."},
+      {"experiment.product_photo", "sieves_mm", "mm", "Sieve sizes of the cumulative passing, increasing."},
+      {"experiment.product_photo", "threshold", "", "Grey level (0-255) above which a pixel is a particle; below 0: Otsu's threshold of the photograph."},
+      {"experiment.product_photo", "outline_iterations", "", "Updates of the plane a particle is sized on (half its size above the tray); 0 sizes it on the tray plane."},
       {"experiment.crusher", "", "", "type = \"crusher\": the cone crusher's run (docs/crusher.md): spheres below discharge_height are product (removed, size and mass in product.csv); ends when the chamber is empty."},
       {"experiment.crusher", "discharge_height", "m", "Height below which a ball's centre is discharged product (below the concave's bottom lip)."},
       {"experiment.crusher", "sieves_mm", "mm", "Sieve sizes of the product's cumulative passing, increasing."},
@@ -510,6 +522,9 @@ scale_depth = 1
 motion_blur = true
 noise_sigma = 1
 light_gain = 1
+ambient = 0.35
+diffuse = 0.65
+specular = 0.2
 [output]
 frame_interval = 0
 energy_interval = 0

@@ -1,7 +1,9 @@
 // Scene reader: [[particles]] sources (lattice, random, list) of spheres or
 // clumps (four_ball, clump files) with their mass properties.
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <numbers>
 #include <sstream>
@@ -158,6 +160,44 @@ BodyShape readClumpShape(TableReader& t, const std::string& shape, double densit
   return body;
 }
 
+// The `diameters_file` of a random source: a CSV whose header names a diameter_mm
+// (or diameter_m) column, one sphere a row: a crusher run's product.csv as it is.
+std::vector<double> readDiameterRadii(TableReader& t, const std::filesystem::path& base_dir) {
+  const std::filesystem::path file = base_dir / t.requiredString("diameters_file");
+  std::ifstream in(file);
+  if (!in) t.fail("diameters_file", "cannot read " + file.string());
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::stringstream cells(line); std::getline(cells, line, ',');) header.push_back(line);
+  const auto column = std::find_if(header.begin(), header.end(),
+                                   [](const std::string& h) { return h == "diameter_mm" || h == "diameter_m"; });
+  if (column == header.end())
+    t.fail("diameters_file", file.string() + ": its first line names no diameter_mm or diameter_m column");
+  const auto index = static_cast<std::size_t>(column - header.begin());
+  const double to_radius = *column == "diameter_mm" ? 0.5e-3 : 0.5;
+  std::vector<double> radii;
+  for (int row = 2; std::getline(in, line); ++row) {
+    if (line.empty()) continue;
+    std::vector<std::string> cells;
+    for (std::stringstream split(line); std::getline(split, line, ',');) cells.push_back(line);
+    double d = 0;
+    std::size_t used = 0;
+    try {
+      d = index < cells.size() ? std::stod(cells[index], &used) : 0.0;
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != cells[index].size() || !(d > 0) || !std::isfinite(d))
+      t.fail("diameters_file", file.string() + " line " + std::to_string(row) + ": the " + *column + " '" +
+                                   (index < cells.size() ? cells[index] : std::string()) +
+                                   "' is not a positive number");
+    radii.push_back(to_radius * d);
+  }
+  if (radii.empty()) t.fail("diameters_file", file.string() + " holds no diameters");
+  return radii;
+}
+
 }  // namespace
 
 void readParticles(TableReader& root, const std::map<std::string, int>& materials,
@@ -220,7 +260,17 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
     } else if (type == "random") {
       const Vec3 lo = t.requiredVec3("region_min"), hi = t.requiredVec3("region_max");
       double r_min = 0, r_max = 0, body_volume = 0;
-      if (clumps) {
+      const bool from_file = t.has("diameters_file");
+      if (clumps && from_file) t.fail("diameters_file", "sizes spheres only (shape = \"sphere\")");
+      if (from_file) {
+        radii = readDiameterRadii(t, base_dir);
+        r_min = *std::min_element(radii.begin(), radii.end());
+        r_max = *std::max_element(radii.begin(), radii.end());
+        double r3 = 0;
+        for (const double r : radii) r3 += r * r * r / static_cast<double>(radii.size());
+        body_volume = 4.0 / 3.0 * std::numbers::pi * r3;
+        if (!((hi - lo).minCoeff() > 2 * r_max)) t.fail("region_max", "the region must be wider than a sphere");
+      } else if (clumps) {
         body_volume = scene.clump_shapes.back().union_volume;
       } else {
         if (t.has("radius")) {
@@ -238,12 +288,15 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
                           : std::pow(r_min, 3);
         body_volume = 4.0 / 3.0 * std::numbers::pi * mean_r3;
       }
-      if (t.has("count") == t.has("solid_fraction"))
+      if (from_file && (t.has("count") || t.has("solid_fraction")))
+        t.fail(t.has("count") ? "count" : "solid_fraction", "diameters_file gives the spheres: one a row");
+      if (!from_file && t.has("count") == t.has("solid_fraction"))
         t.fail("count",
                "give exactly one of count (particles) and "
                "solid_fraction (of the region volume, "
                "so that a size sweep fills the same space)");
-      std::int64_t count = t.integer("count", 0, Range::closed(1, kMaxBalls));
+      std::int64_t count = from_file ? static_cast<std::int64_t>(radii.size())
+                                     : t.integer("count", 0, Range::closed(1, kMaxBalls));
       const double region = (hi - lo).cwiseMax(Vec3::Zero()).prod();
       if (t.has("solid_fraction")) {
         const double f = t.number("solid_fraction", 0, {0.0, 1.0, true, true});
@@ -261,7 +314,7 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
         count = static_cast<std::int64_t>(bodies);
         if (count < 1) t.fail("solid_fraction", "gives no particle in this region");
       } else {
-        checkBallBudget(t, "count", static_cast<double>(count),
+        checkBallBudget(t, from_file ? "diameters_file" : "count", static_cast<double>(count),
                         clumps ? static_cast<double>(body.members.size()) : 1.0, ballsSoFar(scene));
       }
       // What the bodies placed fill of the region, for the message when they stop short.
@@ -285,10 +338,11 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
           orientations.push_back(pose.orientation);
         }
       } else {
-        for (std::int64_t k = 0; k < count; ++k) radii.push_back(rng.uniform(r_min, r_max));
+        if (!from_file)
+          for (std::int64_t k = 0; k < count; ++k) radii.push_back(rng.uniform(r_min, r_max));
         points = geometry::randomNonOverlapping(radii, lo, hi, placed, rng);
         if (points.size() < radii.size())
-          t.fail(t.has("count") ? "count" : "solid_fraction",
+          t.fail(from_file ? "diameters_file" : t.has("count") ? "count" : "solid_fraction",
                  "only " + std::to_string(points.size()) + " of " + std::to_string(radii.size()) +
                      " spheres fit in the region without overlap" + reached(points.size()) + "; enlarge "
                      "region_min/region_max or ask for fewer");

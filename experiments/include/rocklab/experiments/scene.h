@@ -93,6 +93,10 @@ struct CameraSettings {
   bool motion_blur = false;
   double noise_sigma = 0.0;      // grey levels
   double light_gain = 1.0;
+  // Lighting as fractions of a material's colour: ambient (light from all sides,
+  // a sizing station's dome) and the lamp at the camera (diffuse, and the white
+  // specular highlight); render::RenderOptions' defaults.
+  double ambient = 0.35, diffuse = 0.65, specular = 0.20;
 };
 
 /// How a wall is drawn.

@@ -15,6 +15,7 @@
 //   identity swaps — a track paired with one marker and next with another (an exchange
 //                    of two markers' tracks counts two); track changes: a marker paired
 //                    with another track than the last (a new track after a loss, or a swap).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,17 @@ struct MarkerScore {
   double fraction_found = 0.0;  // frames_found / frames_in_view (0 when never in view)
   int track_changes = 0;
   std::vector<int> track_ids;   // tracks it was paired with, in order of first pairing
+  double rms_px = 0.0;          // px, RMS distance tracked − truth over its pairs (0 when none)
+};
+
+/// One truth–track pair of one frame: the truth beside what the tracker said.
+struct PairedPoint {
+  int frame = 0;
+  std::size_t marker = 0;  // index into the truth
+  int track_id = -1;
+  cv::Point2d truth_pixel, tracked_pixel;  // px
+  geometry::Vec3 truth_world = geometry::Vec3::Zero();  // m
+  std::optional<geometry::Vec3> tracked_world;           // m; none when the ray misses the plane
 };
 
 struct TrackingEvaluation {
@@ -72,6 +84,7 @@ struct TrackingEvaluation {
   int identity_swaps = 0;
   int track_changes = 0;
   double fraction_found = 0.0;         // all markers' frames found / frames in view
+  std::vector<PairedPoint> paired;     // every pair, by frame then truth order
 };
 
 /// `camera`, `plane_point`, `plane_normal`: the tracker's own (pixelToPlane), for the
