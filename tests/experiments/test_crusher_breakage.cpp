@@ -200,38 +200,80 @@ TEST_CASE("a ball between two closing walls breaks when q exceeds its strength a
         before.kinetic_translational + before.kinetic_rotational + before.elastic);
 }
 
-TEST_CASE("a freeze that does not end within freeze_max_cycles defers the breakage, or stops with both criteria and "
-          "the keys",
+TEST_CASE("a freeze that does not end within its cap keeps the breakage (break), defers it (defer) or stops the run "
+          "with both criteria and the keys (stop)",
           "[crusher]") {
-  for (const bool defer : {false, true}) {
+  using crusher::CrowdedOutcome;
+  for (const CrowdedOutcome outcome : {CrowdedOutcome::Stop, CrowdedOutcome::Defer, CrowdedOutcome::Break}) {
+    INFO("freeze_crowded = " << crusher::crowdedOutcomeName(outcome));
     std::unique_ptr<sim::World> world = pinchedBall(0.2);
     BreakageSettings settings = pinchSettings();
     settings.freeze.max_cycles = 5;  // the fragments need ~40
     settings.freeze.check_cycles = 1;
-    settings.freeze.defer_crowded = defer;
+    settings.freeze.crowded = outcome;
+    settings.crowded_max_overlap = std::numeric_limits<double>::infinity();  // "break" keeps what 5 cycles leave
     settings.defer_time = 1e-4;  // s: the platens close 20 um in it
     CrusherBreakage breakage(settings, 3);
     const ExperimentContext ctx{1, nullptr};
     breakage.start(*world);
     std::string message;
     const sim::World* before = world.get();
-    int steps = 0;
+    const double parent_mass = world->particles().mass[0];
+    bool broke = false;
     try {
-      for (; steps < 20000 && !breakage.check(world, ctx); ++steps) {
+      for (int steps = 0; steps < 20000 && !(broke = breakage.check(world, ctx)); ++steps) {
         world->step();
-        if (defer && breakage.progress().find("deferred") != std::string::npos) break;
+        if (breakage.progress().find("deferred") != std::string::npos) break;
       }
     } catch (const std::runtime_error& e) {
       message = e.what();
     }
-    if (!defer) {
-      CHECK_THAT(message, Contains("freeze_max_cycles = 5") && Contains("freeze_overlap_fraction") &&
-                              Contains("freeze_kinetic_fraction") && Contains("freeze_defer_crowded"));
+    if (outcome == CrowdedOutcome::Stop) {
+      CHECK_THAT(message, Contains("freeze_max_cycles = 5") && Contains("freeze_max_contact_times") &&
+                              Contains("freeze_overlap_fraction") && Contains("freeze_kinetic_fraction") &&
+                              Contains("freeze_crowded"));
+      continue;
+    }
+    CHECK(message.empty());
+    if (outcome == CrowdedOutcome::Break) {
+      // Kept: one event with the freeze's end "crowded", the fragments where the
+      // freeze left them (still overlapping after 5 cycles) in a new World, the
+      // parent's mass to round-off, and the overlap reported as a stalled one's.
+      REQUIRE(broke);
+      REQUIRE(breakage.events().size() == 1);
+      const BreakageEvent& e = breakage.events().front();
+      CHECK(e.freeze_end == crusher::FreezeEnd::Crowded);
+      CHECK(e.freeze_cycles == 5);
+      CHECK(e.freeze_overlap > settings.freeze.overlap_fraction);
+      CHECK(e.freeze_contact_times > 0);
+      const sim::ParticleState& p = world->particles();
+      REQUIRE(p.size() == 3);
+      double mass = 0, overlap = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        mass += p.mass[i];
+        for (std::size_t j = i + 1; j < p.size(); ++j)
+          overlap = std::max(overlap, (p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm()) /
+                                          std::min(p.radius[i], p.radius[j]));
+      }
+      CHECK(mass == Approx(parent_mass).epsilon(1e-14));
+      CHECK(overlap > 0);
+      CHECK(overlap <= e.freeze_overlap * (1 + 1e-12));  // bounded by what the freeze reported
+      CHECK_THAT(breakage.progress(), Contains("1 broken, freezes 0 converged 0 stalled 1 crowded"));
+      const fs::path out = test::scratchDir("crusher-breakage-crowded");
+      fs::create_directories(out);
+      const nlohmann::json r = breakage.report({8, 16}, out);
+      CHECK(r["freezes_crowded"] == 1);
+      CHECK(r["freezes_converged"] == 0);
+      CHECK(r["max_crowded_overlap_fraction"].get<double>() == e.freeze_overlap);
+      CHECK(r["freeze_crowded"] == "break");
+      CHECK(r["deferred"].empty());
+      CHECK_THAT(test::slurp(out / "breakage.csv"), Contains(",crowded,"));
+      fs::remove_all(out);
       continue;
     }
     // Deferred: no event, the ball whole in the same World, and it is not checked
     // again before defer_time has passed.
-    CHECK(message.empty());
+    CHECK_FALSE(broke);
     CHECK(breakage.events().empty());
     CHECK(world.get() == before);
     CHECK(world->particles().size() == 1);
@@ -245,6 +287,38 @@ TEST_CASE("a freeze that does not end within freeze_max_cycles defers the breaka
     CHECK(breakage.events().empty());
     CHECK_THAT(breakage.progress(), Contains("(1 deferred)"));
   }
+}
+
+TEST_CASE("a crowded freeze under break whose overlap is above freeze_crowded_max_overlap defers its parents, and "
+          "defer_time 0 lets them break at the next check",
+          "[crusher]") {
+  std::unique_ptr<sim::World> world = pinchedBall(0.2);
+  BreakageSettings settings = pinchSettings();
+  settings.freeze.max_cycles = 5;  // cut before the fragments part: crowded at a large overlap
+  settings.freeze.check_cycles = 1;
+  settings.crowded_max_overlap = 1e-3;
+  settings.defer_time = 0;
+  CrusherBreakage breakage(settings, 3);
+  const ExperimentContext ctx{1, nullptr};
+  breakage.start(*world);
+  int steps = 0;
+  while (steps < 20000 && breakage.progress().find("deferred") == std::string::npos) {
+    CHECK_FALSE(breakage.check(world, ctx));
+    world->step();
+    ++steps;
+  }
+  REQUIRE_THAT(breakage.progress(), Contains("(1 deferred)"));
+  CHECK(breakage.events().empty());
+  CHECK(world->particles().size() == 1);
+  // The next check (every step here) tries again: crowded again, deferred again.
+  CHECK_FALSE(breakage.check(world, ctx));
+  CHECK_THAT(breakage.progress(), Contains("(2 deferred)"));
+  const fs::path out = test::scratchDir("crusher-breakage-crowded-bound");
+  fs::create_directories(out);
+  const nlohmann::json r = breakage.report({8, 16}, out);
+  REQUIRE(r["deferred"].size() == 2);
+  CHECK(r["deferred"][0]["overlap_fraction"].get<double>() > settings.crowded_max_overlap);
+  fs::remove_all(out);
 }
 
 namespace {
@@ -345,14 +419,26 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
     crusher::FreezeSettings capped = settings;
     capped.max_cycles = static_cast<std::int64_t>(4 * stalled.cycles);
     FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
-    // By default such a freeze is crowded: it ends so, the state as it was.
+    // Such a freeze is crowded: with "defer" it ends so, the state as it was;
     const std::vector<Vec3> tight_start = tight.state.particles.position;
+    capped.crowded = crusher::CrowdedOutcome::Defer;
     const crusher::FreezeResult crowded =
         crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
     CHECK(crowded.end == crusher::FreezeEnd::Crowded);
     CHECK(crowded.cycles == static_cast<std::uint64_t>(capped.max_cycles));
     CHECK(tight.state.particles.position == tight_start);
-    capped.defer_crowded = false;  // or the run stops, naming the settings
+    // with "break" (the default) the fragments come back where it left them, at the
+    // overlap it reports;
+    capped.crowded = crusher::CrowdedOutcome::Break;
+    const crusher::FreezeResult kept = crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1);
+    CHECK(kept.end == crusher::FreezeEnd::Crowded);
+    CHECK(kept.cycles == crowded.cycles);
+    CHECK(kept.max_overlap == crowded.max_overlap);
+    CHECK(tight.state.particles.position != tight_start);
+    const sim::ParticleState& t = tight.state.particles;
+    CHECK(2 * t.radius[0] - (t.position[1] - t.position[0]).norm() == Approx(kept.max_overlap * 0.005));
+    tight = fragmentRow(2e-3, 1.25e-3);
+    capped.crowded = crusher::CrowdedOutcome::Stop;  // or the run stops, naming the settings
     CHECK_THROWS_WITH(crusher::freezeFragments(tight.model, tight.state, fragments, capped, 1),
                       Contains("freeze_max_cycles") && Contains("freeze_stall_max_overlap = 0.01"));
     capped.stall_max_overlap = 0.3;
@@ -370,11 +456,54 @@ TEST_CASE("a freeze whose fragments are pinched between held walls ends as stall
     crusher::FreezeSettings no_stall = settings;
     no_stall.stall_window = 0;
     no_stall.max_cycles = static_cast<std::int64_t>(3 * stalled.cycles);
-    no_stall.defer_crowded = false;
+    no_stall.crowded = crusher::CrowdedOutcome::Stop;
     FreezeCase again = fragmentRow(1e-4, 25e-6);
     CHECK_THROWS_WITH(crusher::freezeFragments(again.model, again.state, fragments, no_stall, 1),
                       Contains("freeze_max_cycles") && Contains("freeze_stall_window = 0"));
   }
+}
+
+TEST_CASE("the crowded cap in contact times ends a freeze that cannot part long before freeze_max_cycles, which "
+          "stays its upper bound",
+          "[crusher]") {
+  // The tight row: pinched at 0.25 of the radius, above freeze_stall_max_overlap,
+  // it cannot part and does not stall.
+  const std::vector<std::uint32_t> fragments{0, 1};
+  crusher::FreezeSettings settings;  // the defaults: 100 contact times, at most 1e6 cycles, "break"
+  FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult capped = crusher::freezeFragments(tight.model, tight.state, fragments, settings, 1);
+  // A 10 mm fragment at 3e9 kg/m^3 on 1e3 N/m: pi sqrt(m/k) = 3.94 s.
+  const double contact_time = std::numbers::pi * std::sqrt(3e9 * 4.0 / 3.0 * std::numbers::pi * 1.25e-7 / 1e3);
+  INFO("capped: " << capped.cycles << " cycles of " << capped.dt << " s, cap " << capped.cap_cycles << ", overlap "
+                  << capped.max_overlap);
+  CHECK(capped.contact_time == Approx(contact_time).epsilon(1e-12));
+  CHECK(capped.cap_cycles == static_cast<std::uint64_t>(std::ceil(100 * contact_time / capped.dt)));
+  CHECK(capped.end == crusher::FreezeEnd::Crowded);
+  CHECK(capped.cycles >= capped.cap_cycles);
+  CHECK(capped.cycles < capped.cap_cycles + static_cast<std::uint64_t>(settings.check_cycles));
+  CHECK(capped.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 100);
+  CHECK(capped.max_overlap > settings.stall_max_overlap);  // jammed, not slow
+
+  // Without it the same freeze runs into freeze_max_cycles (here 3 times the cap).
+  crusher::FreezeSettings cycles_only = settings;
+  cycles_only.max_contact_times = 0;
+  cycles_only.max_cycles = static_cast<std::int64_t>(3 * capped.cap_cycles);
+  tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult long_run = crusher::freezeFragments(tight.model, tight.state, fragments, cycles_only, 1);
+  CHECK(long_run.end == crusher::FreezeEnd::Crowded);
+  CHECK(long_run.cap_cycles == static_cast<std::uint64_t>(cycles_only.max_cycles));
+  CHECK(long_run.cycles >= 3 * capped.cap_cycles);
+
+  // With every ball in, the rock ball sets the step: 100 contact times are millions
+  // of cycles, and freeze_max_cycles binds.
+  crusher::FreezeSettings all = settings;
+  all.scope = crusher::FreezeScope::All;
+  all.max_cycles = 50000;
+  tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult bounded = crusher::freezeFragments(tight.model, tight.state, fragments, all, 1);
+  CHECK(bounded.end == crusher::FreezeEnd::Crowded);
+  CHECK(bounded.cap_cycles == 50000);
+  CHECK(100 * bounded.contact_time / bounded.dt > 1e6);
 }
 
 TEST_CASE(
@@ -542,6 +671,17 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
              Contains("experiment.breakage.freeze_local_reach"));
   CHECK_THAT(error("experiment.breakage.freeze_held_density=-1"),
              Contains("experiment.breakage.freeze_held_density"));
+  // The boolean freeze_defer_crowded was replaced: a scene that has it is told the new key.
+  CHECK_THAT(error("experiment.breakage.freeze_defer_crowded=true"),
+             Contains("experiment.breakage.freeze_defer_crowded") && Contains("freeze_crowded") &&
+                 Contains("\"defer\""));
+  CHECK_THAT(error("experiment.breakage.freeze_crowded=\"wait\""),
+             Contains("experiment.breakage.freeze_crowded") && Contains("\"break\""));
+  CHECK_THAT(error("experiment.breakage.freeze_max_contact_times=-1"),
+             Contains("experiment.breakage.freeze_max_contact_times"));
+  CHECK(b.freeze.crowded == crusher::CrowdedOutcome::Break);
+  CHECK(settingsOf<CrusherRunSettings>(loadScene(scene, {"experiment.breakage.freeze_crowded=\"defer\""}))
+            .breakage.freeze.crowded == crusher::CrowdedOutcome::Defer);
   CHECK(
       settingsOf<CrusherRunSettings>(loadScene(scene, {"experiment.breakage.freeze_scope=\"all\""}))
           .breakage.freeze.scope == crusher::FreezeScope::All);
@@ -609,13 +749,14 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
     const auto& balance = b["mass_balance"];
     CHECK(balance["feed_kg"].get<double>() ==
           Approx(balance["product_kg"].get<double>() + balance["in_chamber_kg"].get<double>()).epsilon(1e-14));
-    CHECK(b["freezes_converged"].get<int>() + b["freezes_stalled"].get<int>() == b["freezes"].get<int>());
+    CHECK(b["freezes_converged"].get<int>() + b["freezes_stalled"].get<int>() + b["freezes_crowded"].get<int>() ==
+          b["freezes"].get<int>());
     CHECK(b["max_freeze_overlap_fraction"].get<double>() >= 0);
     CHECK(b["freeze_scope"] == "local");
     CHECK(b["max_freeze_balls"].get<int>() >= 3);  // at least the three fragments
     const std::string events = test::slurp(out / "breakage.csv");
     CHECK(std::count(events.begin(), events.end(), '\n') == 1 + b["events"].get<int>());
-    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction\n"));
+    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J\n"));
     if (threads == 1)
       first_events = events;
     else

@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,14 +65,6 @@ sim::Model freezeModel(const sim::Model& run, double t, std::vector<std::int32_t
   return m;
 }
 
-/// Kinetic energy of the balls `rows` (J).
-double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_t>& rows) {
-  double e = 0;
-  for (const std::uint32_t i : rows)
-    e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() + 0.5 * p.omega[i].squaredNorm() / p.inv_inertia[i];
-  return e;
-}
-
 /// The largest overlap of any ball flagged in `is_mover` with a wall, over its radius. The walls
 /// are held, so a fragment pressed into one by its neighbours can stay there; handed
 /// back, that overlap would be at the wall's stiffness (1e13 N/m in series with the
@@ -113,6 +106,22 @@ class OverlapStall {
 
 }  // namespace
 
+double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_t>& rows) {
+  double e = 0;
+  for (const std::uint32_t i : rows)
+    e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() + 0.5 * p.omega[i].squaredNorm() / p.inv_inertia[i];
+  return e;
+}
+
+const char* crowdedOutcomeName(CrowdedOutcome outcome) {
+  switch (outcome) {
+    case CrowdedOutcome::Defer: return "defer";
+    case CrowdedOutcome::Stop: return "stop";
+    case CrowdedOutcome::Break: break;
+  }
+  return "break";
+}
+
 const char* freezeEndName(FreezeEnd end) {
   switch (end) {
     case FreezeEnd::Stalled: return "stalled";
@@ -145,7 +154,7 @@ namespace {
 /// One freeze of `frozen` (a copy of the run's balls, or of the local ones): the
 /// fragments at `density`, the balls flagged in `held` at held_density, all at
 /// rest, cycled until a way out. `after` receives the state at the end when the
-/// freeze converged or stalled.
+/// freeze converged or stalled, or was crowded with crowded "break".
 FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
                        const std::vector<std::uint32_t>& fragments, const std::vector<bool>& held,
                        const FreezeSettings& s, int threads, double t_break,
@@ -171,9 +180,17 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
   result.artificial_energy = fragmentOverlaps(m, world.particles(), fragments).energy;
   double heaviest = 0;  // kg, at the freeze density
   for (const std::uint32_t f : fragments) heaviest = std::max(heaviest, world.particles().mass[f]);
+  const double time_scale = std::sqrt(heaviest / s.stiffness);  // s, the slowest mover's sqrt(m/k)
   if (s.stall_window > 0)
     result.stall_window_cycles =
-        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(s.stall_window * std::sqrt(heaviest / s.stiffness) / result.dt)));
+        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(s.stall_window * time_scale / result.dt)));
+  // The crowded cap in the movers' own time, bounded by the absolute one (head of breakage_freeze.h).
+  result.contact_time = std::numbers::pi * time_scale;
+  result.cap_cycles = static_cast<std::uint64_t>(s.max_cycles);
+  if (s.max_contact_times > 0)
+    result.cap_cycles = std::clamp<std::uint64_t>(
+        static_cast<std::uint64_t>(std::ceil(s.max_contact_times * result.contact_time / result.dt)), 1,
+        result.cap_cycles);
   // At the fragments' own step ("local") the window is a few hundred cycles: the
   // criteria are looked at often enough to see it.
   std::uint64_t check = static_cast<std::uint64_t>(s.check_cycles);
@@ -205,16 +222,18 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
         result.end = FreezeEnd::Stalled;
         break;
       }
-      if (result.cycles >= static_cast<std::uint64_t>(s.max_cycles)) {
-        if (s.defer_crowded) {
+      if (result.cycles >= result.cap_cycles) {
+        if (s.crowded != CrowdedOutcome::Stop) {
           result.end = FreezeEnd::Crowded;
-          return result;
+          if (s.crowded == CrowdedOutcome::Defer) return result;
+          break;  // "break": the fragments go back where they are
         }
         std::ostringstream msg;
         msg << "experiment.breakage: the freeze after breakage at t = " << t_break
-            << " s did not end within "
-            << "freeze_max_cycles = " << s.max_cycles << " cycles: the largest fragment overlap is "
-            << result.max_overlap
+            << " s did not end within " << result.cap_cycles << " cycles (freeze_max_contact_times = "
+            << s.max_contact_times << " contact times of " << result.contact_time << " s at the freeze step "
+            << result.dt << " s, at most freeze_max_cycles = " << s.max_cycles
+            << "): the largest fragment overlap is " << result.max_overlap
             << " of the smaller radius (freeze_overlap_fraction = " << s.overlap_fraction
             << ") and the kinetic energy " << result.kinetic_energy << " J is "
             << result.kinetic_energy / result.artificial_energy << " of the fragments' initial "
@@ -224,7 +243,8 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
             << result.stall_window_cycles
             << " cycles, at an overlap of at most freeze_stall_max_overlap = "
             << s.stall_max_overlap
-            << "); raise freeze_max_cycles, relax the criteria, or set freeze_defer_crowded = true";
+            << "); raise freeze_max_contact_times or freeze_max_cycles, relax the criteria, or set "
+               "freeze_crowded = \"break\" or \"defer\"";
         throw std::runtime_error(msg.str());
       }
     }
@@ -233,6 +253,13 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
   }
   after = world.exportState();
   return result;
+}
+
+/// Whether the positions a freeze reached go back into the run: converged,
+/// stalled, or crowded with crowded "break".
+bool handsBack(FreezeEnd end, CrowdedOutcome crowded) {
+  return end == FreezeEnd::Converged || end == FreezeEnd::Stalled ||
+         (end == FreezeEnd::Crowded && crowded == CrowdedOutcome::Break);
 }
 
 /// The balls within `reach` (m, surface to surface) of any of `fragments`, these included.
@@ -271,7 +298,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     sim::WorldState after;
     const FreezeResult result =
         runFreeze(model, state, fragments, {}, s, threads, state.time, after);
-    if (result.end == FreezeEnd::Converged || result.end == FreezeEnd::Stalled) {
+    if (handsBack(result.end, s.crowded)) {
       state.particles.position = after.particles.position;
       state.pair_history = after.pair_history;
       state.wall_history = after.wall_history;
@@ -317,7 +344,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     total.cycles = cycles;
     total.reach_widenings = widenings;
     total.moved_neighbours = movers.size() - fragments.size();
-    if (result.end != FreezeEnd::Converged && result.end != FreezeEnd::Stalled) return total;
+    if (!handsBack(result.end, s.crowded)) return total;
     std::vector<Vec3> moved;
     for (const std::uint32_t m : local_movers) moved.push_back(after.particles.position[m]);
     if (touchesOutside(p, movers, moved, local) && full_row.size() < p.size()) {

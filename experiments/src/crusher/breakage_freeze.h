@@ -48,14 +48,28 @@
 //     overlap falls as 1 - cos(sqrt(1 - alpha) t / sqrt(m/k)) of the way: 5 % of it
 //     in one time scale, 19 % in the default 2. A window much shorter than that
 //     would call a freeze that has barely started "stalled";
-//   - more than max_cycles ("crowded"): the fragments have found no room. With
-//     defer_crowded (the default) the freeze ends "crowded" and leaves `state` as it
-//     was, and the caller keeps the parents whole for a while (crusher_breakage.h);
-//     otherwise the run stops with a message naming the settings. (The default 1e6
-//     is about five times the longest freeze that ended, 206,000 cycles; in the
-//     200-ball run two freezes after 1 s were still at overlaps of 0.12-0.15 of the
-//     radius after 1e6 and 4e6 cycles, creeping down by less than the stall rule's
-//     tolerance: fragments in a jammed pocket of heavy neighbours.)
+//   - more than its cap ("crowded"): the fragments have found no room. The cap is
+//     max_contact_times contact times pi sqrt(m/k) of the heaviest mover (freeze
+//     mass and stiffness), in cycles of the freeze's step, and never more than
+//     max_cycles. In cycles alone a cap means nothing to the fragments: the old
+//     1e6, sized for the "all" step (one time scale 7,000-14,000 cycles), is
+//     some 10^4 contact times at the local freeze's own step, and each crowded
+//     local freeze of the 200-ball run ran all of them (257 of its 261 million
+//     freeze cycles). From rest under local damping alpha a free pair gains only
+//     (1 - alpha) of its force and has parted after about (pi/2)/sqrt(1 - alpha)
+//     = 5 time scales, 1.6 contact times; the slowest freeze that ended in the
+//     200-ball runs (the triple split's middle fragment leaving the line
+//     sideways, 206,000 cycles of the "all" step) took about 5-10 (15-30 time
+//     scales of 7,000-14,000 cycles, estimated). The default 100 is
+//     ten times that: a freeze that has not parted by then is jammed, not slow.
+//     What follows is `crowded` (CrowdedOutcome): "break" hands the fragments
+//     back where the freeze left them (the caller bounds the overlap it takes:
+//     crusher_breakage.h); "defer" leaves `state` as it was, and the caller keeps
+//     the parents whole for a while; "stop" stops the run with a message naming
+//     the settings. (In the 200-ball run two freezes after 1 s were still at
+//     overlaps of 0.12-0.15 of the radius after 1e6 and 4e6 cycles, creeping down
+//     by less than the stall rule's tolerance: fragments in a jammed pocket of
+//     heavy neighbours.)
 //
 //   - a stop request (rocklab::experiments::stopRequested) is looked at with the
 //     criteria: the freeze ends "interrupted" and leaves `state` as it was.
@@ -94,6 +108,10 @@ namespace rocklab::experiments::crusher {
 enum class FreezeScope { Local, All };
 const char* freezeScopeName(FreezeScope scope);
 
+/// What a crowded freeze leads to (see the head of this file).
+enum class CrowdedOutcome { Break, Defer, Stop };
+const char* crowdedOutcomeName(CrowdedOutcome outcome);
+
 struct FreezeSettings {
   FreezeScope scope = FreezeScope::Local;
   double density = 3e9;           // kg/m^3, every ball's during the freeze ("local": the movers')
@@ -106,15 +124,16 @@ struct FreezeSettings {
   double stall_tolerance = 0.01;   // relative fall of the largest overlap below which it has stalled
   double stall_window = 2.0;       // over this many of the heaviest fragment's sqrt(m/k); 0 = no stall rule
   double stall_max_overlap = 3e-4; // a stall ends the freeze only with the largest overlap at most this
-  std::int64_t max_cycles = 1000000;
-  bool defer_crowded = true;       // at max_cycles: end "crowded" (true) or stop the run
+  double max_contact_times = 100;  // crowded after this many of the heaviest mover's pi sqrt(m/k); 0 = max_cycles only
+  std::int64_t max_cycles = 1000000;  // ...and never after more cycles than this
+  CrowdedOutcome crowded = CrowdedOutcome::Break;  // at the cap: end "crowded" (break, defer) or stop the run
   std::int64_t check_cycles = 20;  // cycles between looks at the criterion (at most a quarter of the stall window)
 };
 
 /// How a freeze ended: both criteria met, the kinetic one with the overlap
-/// stalled, max_cycles passed with defer_crowded, or a stop request (Ctrl-C,
-/// SIGTERM) before either. After the last two the caller keeps the state from
-/// before the breakage.
+/// stalled, its cap passed (crowded "break" or "defer"), or a stop request
+/// (Ctrl-C, SIGTERM) before either. After a crowded "defer" freeze and an
+/// interrupted one `state` is the one from before the breakage.
 enum class FreezeEnd { Converged, Stalled, Crowded, Interrupted };
 const char* freezeEndName(FreezeEnd end);
 
@@ -123,6 +142,8 @@ struct FreezeResult {
   std::uint64_t cycles = 0;        // over every run of it ("local": widened reaches included)
   double dt = 0.0;                 // s, the freeze's own step
   std::uint64_t stall_window_cycles = 0;  // the stall rule's window in cycles (0: off)
+  double contact_time = 0.0;       // s, pi sqrt(m/k) of the heaviest mover at the freeze's mass and stiffness
+  std::uint64_t cap_cycles = 0;    // the crowded cap in cycles: max_contact_times of those, at most max_cycles
   double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
   double max_overlap = 0.0;        // largest fragment overlap / smaller radius (walls: / its radius) at the end
   double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the movers')
@@ -134,8 +155,9 @@ struct FreezeResult {
 /// Relaxes the balls `fragments` (rows of state.particles) of `state` at time
 /// state.time under `model` (the run's); on return state's positions and contact
 /// history are those after the freeze (with scope "local" the fragments' only),
-/// everything else as it was. Throws std::runtime_error (the settings named) when
-/// max_cycles pass before either way out and defer_crowded is off.
+/// everything else as it was (a crowded freeze: only with crowded "break").
+/// Throws std::runtime_error (the settings named) when the cap passes before
+/// either way out and crowded is "stop".
 /// `loaded` (scope "local"; one flag per ball of `state`, or empty): the balls that
 /// bear load, touching a ball other than the broken parents or a wall at the
 /// breakage (sim::World::touchingContacts). A neighbour not loaded moves in the
@@ -144,6 +166,9 @@ struct FreezeResult {
 FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
                              const std::vector<std::uint32_t>& fragments, const FreezeSettings& settings,
                              int threads, const std::vector<bool>& loaded = {});
+
+/// Kinetic energy of the balls `rows` (J): translation and rotation.
+double kineticEnergy(const sim::ParticleState& p, const std::vector<std::uint32_t>& rows);
 
 /// The largest overlap of any of `fragments` with any ball, over the smaller radius
 /// of the pair, and the energy their overlaps store at the stiffnesses of `model`

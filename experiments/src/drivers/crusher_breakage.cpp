@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -50,14 +51,33 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   f.stall_tolerance = b->number("freeze_stall_tolerance", f.stall_tolerance, {0.0, 1.0, false, true});
   f.stall_window = b->number("freeze_stall_window", f.stall_window, Range::closed(0.0, 1e6));
   f.stall_max_overlap = b->number("freeze_stall_max_overlap", f.stall_max_overlap, Range::nonNegative());
+  f.max_contact_times = b->number("freeze_max_contact_times", f.max_contact_times, Range::closed(0.0, 1e12));
   f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
   f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
-  f.defer_crowded = b->boolean("freeze_defer_crowded", f.defer_crowded);
-  s.defer_time = b->number("defer_time", s.defer_time, Range::positive());
+  // The boolean before freeze_crowded (until 2026-12-04): a scene that still has it
+  // is told the new key rather than "unknown key".
+  if (b->has("freeze_defer_crowded"))
+    b->fail("freeze_defer_crowded", "replaced by freeze_crowded: true is \"defer\", false is \"stop\"");
+  using crusher::CrowdedOutcome;
+  const std::vector<CrowdedOutcome> outcomes{CrowdedOutcome::Break, CrowdedOutcome::Defer, CrowdedOutcome::Stop};
+  std::vector<std::string> names;
+  for (const CrowdedOutcome o : outcomes) names.push_back(crusher::crowdedOutcomeName(o));
+  const std::string crowded = b->string("freeze_crowded", crusher::crowdedOutcomeName(f.crowded), names);
+  for (const CrowdedOutcome o : outcomes)
+    if (crowded == crusher::crowdedOutcomeName(o)) f.crowded = o;
+  s.crowded_max_overlap = b->number("freeze_crowded_max_overlap", s.crowded_max_overlap, Range::nonNegative());
+  s.defer_time = b->number("defer_time", s.defer_time, Range::nonNegative());
   b->finish();
 }
 
 namespace {
+
+// The kinetic-energy jump after a breakage is followed for this many contact
+// times pi sqrt(m/k) of the heaviest fragment at its rock stiffness: an overlap
+// handed back is spent within about one (the pair's spring in series and its
+// reduced mass keep the same ratio), and a longer window takes in more of the
+// chamber's own changes (the mantle's work, other impacts).
+constexpr double kJumpWindow = 5;
 
 std::string mm(double metres) {
   std::ostringstream s;
@@ -152,7 +172,19 @@ double CrusherBreakage::automaticCheckInterval(const sim::Model& model, const si
   return interval;
 }
 
+void CrusherBreakage::watchKineticJump(const sim::World& world) {
+  if (!jump_watch_) return;
+  const sim::ParticleState& p = world.particles();
+  std::vector<std::uint32_t> rows(p.size());
+  std::iota(rows.begin(), rows.end(), 0u);
+  const double jump = crusher::kineticEnergy(p, rows) - jump_watch_->before;
+  for (std::size_t k = jump_watch_->first_event; k < jump_watch_->end_event; ++k)
+    events_[k].kinetic_jump = std::max(events_[k].kinetic_jump, jump);
+  if (world.time() >= jump_watch_->until) jump_watch_.reset();
+}
+
 bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+  watchKineticJump(*world);
   if (world->stepCount() % every_ != 0) return false;
   const sim::ParticleState& p = world->particles();
   if (p.size() == 0) return false;
@@ -200,7 +232,12 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   const auto class_material_before = class_material_;
   for (const Broken& b : broken) {
     const std::uint32_t i = b.row;
-    BreakageEvent e{world->time(), p.id[i], 2 * p.radius[i], b.q, b.strength, {}, 0};
+    BreakageEvent e;
+    e.time = world->time();
+    e.parent = p.id[i];
+    e.diameter = 2 * p.radius[i];
+    e.q = b.q;
+    e.strength = b.strength;
     e.mass = p.mass[i];
     for (const crusher::FragmentBall& f :
          crusher::splitBall(p.position[i], p.radius[i], p.mass[i], b.direction, s_.mode, s_.offsets)) {
@@ -216,13 +253,21 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   loaded.resize(state.particles.size(), false);  // the fragments
   const crusher::FreezeResult freeze =
       crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads, loaded);
-  if (freeze.end == crusher::FreezeEnd::Interrupted || freeze.end == crusher::FreezeEnd::Crowded) {
+  // A crowded freeze keeps its breakage with "break" while the overlap it leaves is
+  // within the bound (handed back at rock stiffness an overlap f R loads a ball to
+  // q = 0.9 E_c f: BreakageSettings); otherwise, and with "defer", the parents wait.
+  const bool crowded = freeze.end == crusher::FreezeEnd::Crowded;
+  const bool kept = freeze.end != crusher::FreezeEnd::Interrupted &&
+                    (!crowded || (s_.freeze.crowded == crusher::CrowdedOutcome::Break &&
+                                  freeze.max_overlap <= s_.crowded_max_overlap));
+  if (!kept) {
     events_.resize(first_event);
     next_id_ = next_id_before;
     base_of_ = base_of_before;
     class_material_ = class_material_before;
-    if (freeze.end == crusher::FreezeEnd::Crowded) {
-      // No room for the fragments: the parents stay whole for defer_time, then may break again.
+    if (crowded) {
+      // No room for the fragments: the parents stay whole for defer_time (0: until
+      // the next check), then may break again where the chamber has moved on.
       Deferral d{world->time(), {}, freeze.cycles, freeze.max_overlap};
       for (const Broken& b : broken) {
         d.parents.push_back(p.id[b.row]);
@@ -234,14 +279,28 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     }
     return false;
   }
+  const double contact_times = static_cast<double>(freeze.cycles) * freeze.dt / freeze.contact_time;
+  double jump_window = 0;  // s, kJumpWindow contact times of the heaviest fragment at rock stiffness
   for (std::size_t k = first_event; k < events_.size(); ++k) {
     events_[k].freeze_cycles = freeze.cycles;
     events_[k].freeze_end = freeze.end;
     events_[k].freeze_overlap = freeze.max_overlap;
+    events_[k].freeze_contact_times = contact_times;
   }
+  for (const std::uint32_t f : rows)
+    jump_window = std::max(jump_window, kJumpWindow * std::numbers::pi *
+                                            std::sqrt(state.particles.mass[f] /
+                                                      model.materials[state.particles.material[f]].kn));
+  std::vector<std::uint32_t> all(p.size());
+  std::iota(all.begin(), all.end(), 0u);
+  jump_watch_ = JumpWatch{crusher::kineticEnergy(p, all), world->time() + jump_window, first_event, events_.size()};
   fragments_created_ += rows.size();
   ++freezes_;
   if (freeze.end == crusher::FreezeEnd::Stalled) ++freezes_stalled_;
+  if (crowded) {
+    ++freezes_crowded_;
+    max_crowded_overlap_ = std::max(max_crowded_overlap_, freeze.max_overlap);
+  }
   max_freeze_overlap_ = std::max(max_freeze_overlap_, freeze.max_overlap);
   freeze_cycles_ += freeze.cycles;
   max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
@@ -257,8 +316,9 @@ std::string CrusherBreakage::progress() const {
   s << events_.size() << " broken";
   if (!deferrals_.empty()) s << " (" << deferrals_.size() << " deferred)";
   if (freezes_ > 0)
-    s << ", freezes " << freezes_ - freezes_stalled_ << " converged " << freezes_stalled_ << " stalled (overlap left <= "
-      << max_freeze_overlap_ << ", " << freeze_cycles_ << " cycles)";
+    s << ", freezes " << freezes_ - freezes_stalled_ - freezes_crowded_ << " converged " << freezes_stalled_
+      << " stalled " << freezes_crowded_ << " crowded (overlap left <= " << max_freeze_overlap_ << ", "
+      << freeze_cycles_ << " cycles)";
   return s.str();
 }
 
@@ -278,12 +338,18 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   std::ostringstream csv;
   csv.precision(17);
   csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles,freeze_end,"
-         "freeze_overlap_fraction\n";
+         "freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J\n";
   for (const BreakageEvent& e : events_) {
     csv << e.time << ',' << e.parent << ',' << e.diameter * 1e3 << ',' << e.q * 1e-6 << ',' << e.strength * 1e-6 << ','
         << crusher::modeName(s_.mode) << ',';
     for (std::size_t k = 0; k < e.fragments.size(); ++k) csv << (k ? ";" : "") << e.fragments[k];
-    csv << ',' << e.freeze_cycles << ',' << crusher::freezeEndName(e.freeze_end) << ',' << e.freeze_overlap << '\n';
+    csv << ',' << e.freeze_cycles << ',' << crusher::freezeEndName(e.freeze_end) << ',' << e.freeze_overlap << ','
+        << e.freeze_contact_times << ',' << e.kinetic_jump << '\n';
+  }
+  double max_jump = 0, max_crowded_jump = 0;
+  for (const BreakageEvent& e : events_) {
+    max_jump = std::max(max_jump, e.kinetic_jump);
+    if (e.freeze_end == crusher::FreezeEnd::Crowded) max_crowded_jump = std::max(max_crowded_jump, e.kinetic_jump);
   }
   detail::writeAtomically(out_dir / "breakage.csv", csv.str());
   nlohmann::json b;
@@ -293,9 +359,16 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["freezes"] = freezes_;
   b["freeze_cycles"] = freeze_cycles_;
   b["max_freeze_cycles"] = max_freeze_cycles_;
-  b["freezes_converged"] = freezes_ - freezes_stalled_;
+  b["freezes_converged"] = freezes_ - freezes_stalled_ - freezes_crowded_;
   b["freezes_stalled"] = freezes_stalled_;
+  b["freezes_crowded"] = freezes_crowded_;
   b["max_freeze_overlap_fraction"] = max_freeze_overlap_;
+  b["max_crowded_overlap_fraction"] = max_crowded_overlap_;
+  b["max_kinetic_jump_J"] = max_jump;
+  b["max_crowded_kinetic_jump_J"] = max_crowded_jump;
+  b["freeze_crowded"] = crusher::crowdedOutcomeName(s_.freeze.crowded);
+  b["freeze_crowded_max_overlap"] = s_.crowded_max_overlap;
+  b["freeze_max_contact_times"] = s_.freeze.max_contact_times;
   b["freeze_scope"] = crusher::freezeScopeName(s_.freeze.scope);
   b["max_freeze_balls"] = max_freeze_balls_;
   b["freeze_reach_widenings"] = reach_widenings_;

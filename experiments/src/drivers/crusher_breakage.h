@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,9 +35,25 @@ struct BreakageSettings {
   double youngs_modulus = 70e9;  // Pa, E_c of the fragments' k = 4 R E_c (Eq 6-14)
   double class_ratio = 1.25;     // fragment size classes: diameters min_diameter x ratio^i .. ^(i+1)
   crusher::FreezeSettings freeze;
-  // s a ball whose fragments found no room (a "crowded" freeze) stays whole before
-  // it may break again; a choice of ours, the reference's freeze has no such case.
-  double defer_time = 2e-3;
+  // A crowded freeze (its fragments found no room; the reference's freeze has no
+  // such case) with freeze.crowded "break" keeps the breakage only while its
+  // largest overlap is at most this fraction of the smaller radius; above it the
+  // parents are deferred as with "defer". The stall bound's reason
+  // (breakage_freeze.h): handed back at k = 4 R E_c an overlap f R loads a ball to
+  // q = 0.9 E_c f, 19 MPa at 3e-4, below the feed's strengths. Measured on the
+  // three-ball nip with the cap cut to 2 contact times (docs/crusher.md, seventh
+  // attempt): crowded freezes kept at 0.13-0.24 fired 97-251 J into a chamber whose
+  // converged freezes add at most 2 uJ, and 17 balls were thrown out of it.
+  double crowded_max_overlap = 3e-4;
+  // s a deferred parent stays whole before it may break again; 0 = until the next
+  // check. While it waits the closing mantle loads it, q = 0.9 k v t / d^2: where
+  // the PBM chamber closes fastest (the closed side's bottom, whose gap swings by
+  // +-6.6 mm at omega: v = 0.21 m/s) a ball of d = 8-28 mm at k = 4 R E_c gains
+  // about its own strength q0(d) in 17-22 us. The 2 ms used until 2026-12-04 let it
+  // gain up to ~100 strengths (the 200-ball run's mantle power swings). Until the
+  // next check instead costs a crowded freeze at every check (every 0.35 us in the
+  // 200-ball run) for as long as the pocket stays jammed.
+  double defer_time = 2e-5;
 };
 
 /// Reads [experiment.breakage] (the `breakage` table of the experiment's table).
@@ -54,6 +71,11 @@ struct BreakageEvent {
   std::uint64_t freeze_cycles = 0;
   crusher::FreezeEnd freeze_end = crusher::FreezeEnd::Converged;
   double freeze_overlap = 0;
+  double freeze_contact_times = 0;  // its length in the heaviest mover's contact times (its cap's unit)
+  // J, the largest rise of the run's kinetic energy within kJumpWindow contact
+  // times of the heaviest fragment (rock stiffness) after the check, over its value
+  // just before: what the fragments' handed-back overlaps fired (shared by the check's events).
+  double kinetic_jump = 0;
   double mass = 0;  // kg, the parent's
   std::vector<double> fragment_diameters, fragment_masses;  // m, kg; in the order of `fragments`
 };
@@ -97,6 +119,14 @@ class CrusherBreakage {
   std::map<int, int> base_of_;                    // fragment material -> the feed material it copies
   std::map<std::pair<int, int>, int> class_material_;  // (feed material, class) -> material
   std::vector<BreakageEvent> events_;
+  /// Follows the run's kinetic energy after a check that broke balls (BreakageEvent::kinetic_jump).
+  void watchKineticJump(const sim::World& world);
+  struct JumpWatch {
+    double before = 0;  // J, just before the check
+    double until = 0;   // s
+    std::size_t first_event = 0, end_event = 0;
+  };
+  std::optional<JumpWatch> jump_watch_;
   struct Deferral {  // a crowded freeze: its time, parents, cycles and the overlap it left
     double time = 0;
     std::vector<std::uint64_t> parents;
@@ -107,8 +137,9 @@ class CrusherBreakage {
   std::map<std::uint64_t, double> deferred_until_;  // id -> time before which it does not break
   std::size_t fragments_created_ = 0;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
-  std::uint64_t freezes_stalled_ = 0;
+  std::uint64_t freezes_stalled_ = 0, freezes_crowded_ = 0;  // crowded: kept with freeze_crowded "break"
   double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left
+  double max_crowded_overlap_ = 0;        // ...a crowded one whose breakage was kept
   std::size_t max_freeze_balls_ = 0;      // the most balls a freeze World held
   std::uint64_t reach_widenings_ = 0;     // "local" freezes run again with a wider reach
   std::uint64_t moved_neighbours_ = 0;    // "local": loose neighbours the freezes moved

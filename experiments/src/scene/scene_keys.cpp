@@ -317,9 +317,12 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher.breakage", "freeze_stall_tolerance", "", "The freeze also ends (\"stalled\") when the kinetic criterion holds and the largest fragment overlap has not fallen below (1 - this) of its value freeze_stall_window ago: fragments pinched between the held walls or heavy neighbours, whose overlap cannot reach freeze_overlap_fraction."},
       {"experiment.crusher.breakage", "freeze_stall_window", "", "The window of the stall rule in the heaviest fragment's time scale sqrt(m/k) at the freeze density and stiffness (not in cycles: the freeze's step is set by the unbroken balls); 0 = no stall rule (only the overlap criterion ends a freeze)."},
       {"experiment.crusher.breakage", "freeze_stall_max_overlap", "", "The stall rule ends a freeze only when the largest fragment overlap (with a ball or a wall) is at most this fraction of the smaller radius: handed back at rock stiffness k = 4 R E_c an overlap f R loads a ball to q = 0.9 E_c f (19 MPa at the default 3e-4, below the feed's strengths); higher plateaus are squeezes the fragments leave later, or crowded freezes."},
-      {"experiment.crusher.breakage", "freeze_max_cycles", "", "A freeze that has not ended either way after this many cycles is crowded: its fragments found no room (freeze_defer_crowded says what follows)."},
-      {"experiment.crusher.breakage", "freeze_defer_crowded", "", "After a crowded freeze: true keeps its parents whole for defer_time (results.json breakage.deferred); false stops the run with the criteria's values."},
-      {"experiment.crusher.breakage", "defer_time", "s", "How long a ball whose fragments found no room stays whole before it may break again."},
+      {"experiment.crusher.breakage", "freeze_max_contact_times", "", "A freeze that has not ended either way after this many contact times pi sqrt(m/k) of its heaviest mover (fragments and loose neighbours, at freeze_density and freeze_stiffness) is crowded: its fragments found no room (freeze_crowded says what follows). Free fragments part in about 1.6 (5 sqrt(m/k) under local damping 0.9), the slowest freeze seen to part took 5-10; 0 = freeze_max_cycles only."},
+      {"experiment.crusher.breakage", "freeze_max_cycles", "", "...and never more cycles than this (the cap in cycles of the freeze's own step; with freeze_scope \"all\" the rock balls set that step, and this is the cap that binds)."},
+      {"experiment.crusher.breakage", "freeze_crowded", "", "After a crowded freeze: \"break\" keeps the breakage with the fragments where the freeze left them (freeze_end \"crowded\" in breakage.csv) while its largest overlap is at most freeze_crowded_max_overlap, otherwise the parents wait as with \"defer\"; \"defer\" keeps the parents whole for defer_time (results.json breakage.deferred); \"stop\" stops the run with the criteria's values.", "\"break\", \"defer\", \"stop\""},
+      {"experiment.crusher.breakage", "freeze_crowded_max_overlap", "", "freeze_crowded = \"break\": the largest fragment overlap (fraction of the smaller radius, of its own with a wall) a crowded freeze may hand back; an overlap f R at rock stiffness k = 4 R E_c loads a ball to q = 0.9 E_c f (19 MPa at the default 3e-4, as freeze_stall_max_overlap)."},
+      {"experiment.crusher.breakage", "freeze_defer_crowded", "", "Replaced by freeze_crowded (true is \"defer\", false \"stop\"); a scene that still has it is refused with that message.", "none", "none"},
+      {"experiment.crusher.breakage", "defer_time", "s", "How long a ball whose fragments found no room stays whole before it may break again; 0 = until the next check. The closing mantle loads a whole ball while it waits: where the PBM chamber closes fastest, by about its own strength in 17-22 us (docs/crusher.md)."},
       {"experiment.crusher.breakage", "freeze_check_cycles", "", "Cycles between looks at the freeze's end criterion (at most a quarter of the stall window)."},
       {"experiment.zwick", "", "", "type = \"zwick\": an agglomerate crushed between two plane platens; failure load and strength."},
       {"experiment.zwick", "bottom_platen", "", "Plane wall the specimen rests on.", "a plane wall name"},
@@ -607,10 +610,12 @@ freeze_kinetic_fraction = 0.2
 freeze_stall_tolerance = 0.01
 freeze_stall_window = 2
 freeze_stall_max_overlap = 3e-4
+freeze_max_contact_times = 100
 freeze_max_cycles = 1000000
 freeze_check_cycles = 20
-freeze_defer_crowded = true
-defer_time = 2e-3
+freeze_crowded = "break"
+freeze_crowded_max_overlap = 3e-4
+defer_time = 2e-5
 )",
 };
 
