@@ -20,9 +20,9 @@ struct PairProps {
   double hertz_ks_per_secant = 0.0;  // Hertz: hertz_ks / hertz_cn^(2/3); times K^n gives k_s (no cube root)
 };
 
-PairProps ballBallProps(const Material& a, const Material& b);
+PairProps ballBallProps(const Material& a, const Material& b, FrictionRule rule = FrictionRule::Min);
 /// Mirror rule for Hertz (ref §4.2): the ball's own G and nu; series springs for linear.
-PairProps ballWallProps(const Material& ball, const Material& wall);
+PairProps ballWallProps(const Material& ball, const Material& wall, FrictionRule rule = FrictionRule::Min);
 
 /// Mass of a ball–ball dashpot (Eq 2-18); a ball–wall dashpot uses the ball's mass.
 inline double dampingMass(DampingMass kind, double ma, double mb) {

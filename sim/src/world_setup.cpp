@@ -331,8 +331,8 @@ void World::Impl::buildPairProps() {
   ball_wall.resize(nm * nm);
   for (std::size_t a = 0; a < nm; ++a)
     for (std::size_t b = 0; b < nm; ++b) {
-      ball_ball[a * nm + b] = detail::ballBallProps(model.materials[a], model.materials[b]);
-      ball_wall[a * nm + b] = detail::ballWallProps(model.materials[a], model.materials[b]);
+      ball_ball[a * nm + b] = detail::ballBallProps(model.materials[a], model.materials[b], model.contact.friction_rule);
+      ball_wall[a * nm + b] = detail::ballWallProps(model.materials[a], model.materials[b], model.contact.friction_rule);
     }
 }
 

@@ -222,3 +222,27 @@ TEST_CASE("a spinning faceted frustum wall: the contact velocity has no spin nor
   }
   CHECK(checked >= 3);  // the faceting really gives the spin a normal part here
 }
+
+TEST_CASE("the friction rule picks the smaller, the larger or the mean of the two materials", "[walls]") {
+  // A ball sliding on the floor without spin decelerates at mu g until it rolls
+  // (at t = 2 v0 / (7 mu g), 48 ms for mu = 0.605): measured at 20 ms.
+  const auto slide = [](sim::FrictionRule rule) {
+    auto model = test::linearModel(2e7, 0.0, 0.2);
+    model.materials[0].friction = 0.37;   // ball
+    model.materials[1].friction = 0.605;  // floor
+    model.contact.friction_rule = rule;
+    model.gravity = Vec3(0, 0, -9.81);
+    sim::Wall floor = test::floorPlane();
+    floor.material = 1;
+    model.walls.push_back(floor);
+    // Resting on the floor under its own weight: centre at r minus the static overlap m g / kn.
+    const double r = 0.01, m = 2730.0 * 4.0 / 3.0 * M_PI * r * r * r;
+    sim::World w(model, {test::sphere(Vec3(0, 0, r - m * 9.81 / 1e7), r, {1.0, 0, 0})}, 1);
+    const double t = 0.02;
+    while (w.time() < t) w.step();
+    return (1.0 - w.particles().velocity[0].x()) / (9.81 * w.time());  // the mu it slid with
+  };
+  CHECK(slide(sim::FrictionRule::Min) == Approx(0.37).epsilon(0.02));  // Eq 2-39, the default
+  CHECK(slide(sim::FrictionRule::Max) == Approx(0.605).epsilon(0.02));
+  CHECK(slide(sim::FrictionRule::Mean) == Approx(0.4875).epsilon(0.02));
+}

@@ -12,8 +12,6 @@
 #include <ostream>
 #include <sstream>
 
-#include <opencv2/imgproc.hpp>
-
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "crusher/product_statistics.h"

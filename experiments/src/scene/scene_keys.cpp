@@ -61,6 +61,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"contact", "damping_normal", "", "Critical damping ratio beta of the normal dashpot (Eq 2-17)."},
       {"contact", "damping_shear", "", "Critical damping ratio of the shear dashpot.", nullptr, "damping_normal"},
       {"contact", "damping_mass", "", "Mass of a ball-ball dashpot: the study's average of the two masses, or the reduced mass."},
+      {"contact", "friction_rule", "", "Friction of a contact between two materials (ball-ball and ball-wall): the smaller of the two (the study's Eq 2-39), the larger (a base measured against the pebbles acts at its own value), or the mean."},
       {"contact", "local_damping", "", "Cundall's local damping alpha (Eq 2-15, sign form); 0 = off."},
       {"contact", "stiffness_scale", "", "Factor on every material's kn, ks and shear_modulus (one key for a stiffness study)."},
 
@@ -375,6 +376,7 @@ law = "linear"
 damping_normal = 0.1
 damping_shear = 0.1
 damping_mass = "reduced"
+friction_rule = "min"
 local_damping = 0.0
 stiffness_scale = 1.0
 [gravity]

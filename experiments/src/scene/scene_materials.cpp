@@ -79,6 +79,10 @@ void readContact(TableReader& root, sim::Model& model) {
     model.contact.damping_mass =
         mass == "average" ? sim::DampingMass::Average : sim::DampingMass::Reduced;
     model.contact.local_damping = t->number("local_damping", 0.0, {0.0, 1.0, false, true});
+    const std::string rule = t->string("friction_rule", "min", {"min", "max", "mean"});
+    model.contact.friction_rule = rule == "min"   ? sim::FrictionRule::Min
+                                  : rule == "max" ? sim::FrictionRule::Max
+                                                  : sim::FrictionRule::Mean;
     // Stiffness scaling, the usual way DEM users buy speed (dt_crit ~
     // 1/sqrt(k)): one factor on every material's kn, ks and G, so a study
     // varies one key.

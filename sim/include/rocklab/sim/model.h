@@ -32,8 +32,16 @@ enum class DampingMass {
   Reduced,  // the usual two-body value: m_A m_B / (m_A + m_B)
 };
 
+/// Friction coefficient of a contact between two materials (ball-ball, ball-wall).
+enum class FrictionRule {
+  Min,   // the study's Eq 2-39: the smaller of the two
+  Max,   // the larger: a base measured against the pebbles acts at its own value
+  Mean,  // the arithmetic mean
+};
+
 struct ContactModel {
   ContactLaw law = ContactLaw::Linear;
+  FrictionRule friction_rule = FrictionRule::Min;
   double damping_normal = 0.0;  // -  beta_n, critical damping ratio of the normal dashpot (Eq 2-17)
   double damping_shear = 0.0;   // -  beta_s, same for the shear dashpot
   DampingMass damping_mass = DampingMass::Average;
