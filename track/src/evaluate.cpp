@@ -108,8 +108,9 @@ TrackingEvaluation evaluateTracks(const std::vector<Track>& tracks, const std::v
   out.pixel_error = {u.error("u"), v.error("v")};
   for (std::size_t a = 0; a < axes.size(); ++a) out.world_error.push_back(world[a].error(axes[a].name));
   int in_view = 0, found_frames = 0;
-  for (std::size_t m = 0; m < out.markers.size(); ++m) out.markers[m].rms_px = marker_distance[m].error("").rms;
-  for (MarkerScore& s : out.markers) {
+  for (std::size_t m = 0; m < out.markers.size(); ++m) {
+    MarkerScore& s = out.markers[m];
+    s.rms_px = marker_distance[m].error("").rms;
     s.fraction_found = s.frames_in_view ? static_cast<double>(s.frames_found) / s.frames_in_view : 0.0;
     out.track_changes += s.track_changes;
     in_view += s.frames_in_view;

@@ -187,7 +187,10 @@ SizingResult sizeParticles(const cv::Mat& bgr, const geometry::Camera& camera, c
       sized = true;
       height = 0.5 * s.equivalent_diameter_m;
     }
-    if (sized) out.particles.push_back(s);
+    if (sized)
+      out.particles.push_back(s);
+    else  // its outline meets no plane (a ray off the surface's side): background, as SizingResult::labels says
+      for (const cv::Point& p : mine) out.labels.at<int>(p) = 0;
   }
   return out;
 }

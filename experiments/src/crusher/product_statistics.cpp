@@ -86,14 +86,15 @@ nlohmann::json PowerMeter::report() const {
            "from the first to the end of the last sample interval in which they did work"}};
 }
 
+nlohmann::json sizeAtPassingMm(std::span<const ProductBall> balls, double fraction) {
+  const std::optional<double> d = sizeAtPassing(balls, fraction);
+  return d ? nlohmann::json(*d * 1e3) : nlohmann::json(nullptr);
+}
+
 nlohmann::json productStatistics(std::span<const ProductBall> product) {
-  auto size_mm = [&](double fraction) {
-    const std::optional<double> d = sizeAtPassing(product, fraction);
-    return d ? nlohmann::json(*d * 1e3) : nlohmann::json(nullptr);
-  };
   nlohmann::json s;
-  s["p50_mm"] = size_mm(0.5);
-  s["p80_mm"] = size_mm(0.8);
+  s["p50_mm"] = sizeAtPassingMm(product, 0.5);
+  s["p80_mm"] = sizeAtPassingMm(product, 0.8);
   double mass = 0, first = std::numeric_limits<double>::infinity(), last = -first;
   std::vector<double> residence;
   for (const ProductBall& b : product) {

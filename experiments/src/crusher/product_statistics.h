@@ -25,6 +25,9 @@ struct ProductBall {
 /// the smallest diameter below its own fraction. Empty without balls.
 std::optional<double> sizeAtPassing(std::span<const ProductBall> balls, double fraction);
 
+/// sizeAtPassing in mm for results.json: null without balls.
+nlohmann::json sizeAtPassingMm(std::span<const ProductBall> balls, double fraction);
+
 /// Mass fraction of `balls` finer than each of `sieves_mm` (mm), as a sieve chart's
 /// cumulative passing; 0 at every sieve without balls.
 std::vector<double> massPassing(std::span<const ProductBall> balls, const std::vector<double>& sieves_mm);

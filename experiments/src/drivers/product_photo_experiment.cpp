@@ -24,11 +24,6 @@ namespace {
 
 using crusher::ProductBall;
 
-nlohmann::json sizeAt(const std::vector<ProductBall>& balls, double fraction) {
-  const auto d = crusher::sizeAtPassing(balls, fraction);
-  return d ? nlohmann::json(*d * 1e3) : nlohmann::json(nullptr);
-}
-
 struct TrueBall {
   geometry::Vec3 centre;
   double radius = 0;  // m
@@ -153,10 +148,10 @@ class ProductPhotoExperiment final : public Experiment {
       worst_class = std::max(worst_class, std::abs(image_passing[k] - truth_passing[k]));
     }
     s["psd"] = psd;
-    s["p50_mm"] = {{"truth", sizeAt(truth, 0.5)}, {"image", sizeAt(image_equivalent, 0.5)},
-                   {"image_feret_min", sizeAt(image_feret, 0.5)}};
-    s["p80_mm"] = {{"truth", sizeAt(truth, 0.8)}, {"image", sizeAt(image_equivalent, 0.8)},
-                   {"image_feret_min", sizeAt(image_feret, 0.8)}};
+    for (const auto& [key, fraction] : {std::pair{"p50_mm", 0.5}, std::pair{"p80_mm", 0.8}})
+      s[key] = {{"truth", crusher::sizeAtPassingMm(truth, fraction)},
+                {"image", crusher::sizeAtPassingMm(image_equivalent, fraction)},
+                {"image_feret_min", crusher::sizeAtPassingMm(image_feret, fraction)}};
     s["max_passing_error_points"] = 100 * worst_class;
     s["particles"] = {{"true_in_view", truth.size()}, {"out_of_view", out_of_view}, {"found", sized.particles.size()},
                       {"matched", matched}, {"merged", merged}, {"balls_hidden_or_merged", hidden_balls},
