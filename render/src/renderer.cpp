@@ -90,6 +90,7 @@ struct Renderer::Impl {
   void updateOpaqueLayer(const FrameDescription& frame, const ViewUniforms& view) {
     std::vector<double> key = surfaces->opaqueSignature();
     key.insert(key.end(), {frame.background.r, frame.background.g, frame.background.b, view.gain});
+    key.insert(key.end(), view.cutPlane.begin(), view.cutPlane.end());
     if (key == opaqueKey) return;
     const Framebuffer& layer = multisampled ? *multisampled : *opaque;
     layer.bindForDrawing();
@@ -109,7 +110,8 @@ struct Renderer::Impl {
 
   // One undistorted canvas image (BGRA) with the spheres moved by velocity × dt.
   void drawCanvas(const FrameDescription& frame, const ViewUniforms& view, double dt) {
-    spheres->upload(frame.spheres, camera.rotation, camera.translation, lens.canvas, options.nearClip, options.farClip, dt);
+    spheres->upload(frame.spheres, camera.rotation, camera.translation, lens.canvas, options.nearClip, options.farClip, dt,
+                    frame.cut);
     // 1. opaque walls: a copy of the cached layer (colour and depth)
     opaque->blitTo(*target);
     target->bindForDrawing();
@@ -133,6 +135,13 @@ struct Renderer::Impl {
     ViewUniforms view = makeViewUniforms(lens.canvas, options.nearClip, options.farClip);
     view.lighting = {options.ambient, options.diffuse, options.specular, options.shininess};
     view.gain = static_cast<float>(frame.lightGain);
+    if (frame.cut) {
+      // The plane in the camera frame: n_c = R n (unit), d = −n_c · (R p + t).
+      const geometry::Vec3 n = camera.rotation * frame.cut->normal.normalized();
+      const double d = -n.dot(camera.rotation * frame.cut->point + camera.translation);
+      view.cutPlane = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()),
+                       static_cast<float>(d)};
+    }
     surfaces->prepare(frame, camera.rotation, camera.translation);
     updateOpaqueLayer(frame, view);
 

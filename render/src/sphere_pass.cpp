@@ -68,7 +68,7 @@ void SpherePass::setAttributes(GLuint vao, std::size_t firstInstance, GLuint div
 
 void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geometry::Mat3& rotation,
                         const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip,
-                        double dt) {
+                        double dt, const std::optional<CutPlane>& cut) {
   // Side planes of the canvas frustum (through the eye, two pixels outside the
   // canvas edges), inward unit normals: a sphere with n·c < −r is invisible.
   const double xl = (-2.5 - canvas.cx) / canvas.fx, xr = (canvas.width + 1.5 - canvas.cx) / canvas.fx;
@@ -91,7 +91,10 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
     out.colours.clear();
     for (std::size_t i = n * b / chunks; i < n * (b + 1) / chunks; ++i) {
       const SphereInstance& s = spheres[i];
-      const geometry::Vec3 c = rotation * (s.centre + dt * s.velocity) + translation;
+      const geometry::Vec3 centre = s.centre + dt * s.velocity;
+      // Cut away: a sphere goes whole when its centre lies beyond the plane.
+      if (cut && (centre - cut->point).dot(cut->normal) > 0.0) continue;
+      const geometry::Vec3 c = rotation * centre + translation;
       const double r = s.radius;
       // Not drawn: crossing the near plane (the impostor needs the eye outside), wholly beyond far, outside the sides.
       if (c.z() - r < nearClip || c.z() - r > farClip) continue;

@@ -7,6 +7,7 @@
 // instanced quads, drawn after the points.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "rocklab/render/frame.h"
@@ -24,9 +25,11 @@ class SpherePass {
   SpherePass& operator=(const SpherePass&) = delete;
 
   /// Moves each centre by velocity × dt (motion-blur subframes; dt = 0 otherwise),
-  /// transforms to the camera frame (double), culls, sorts, uploads.
+  /// drops the spheres whose (moved) centre lies beyond the cut, transforms to the
+  /// camera frame (double), culls, sorts, uploads.
   void upload(const std::vector<SphereInstance>& spheres, const geometry::Mat3& rotation,
-              const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip, double dt);
+              const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip, double dt,
+              const std::optional<CutPlane>& cut = std::nullopt);
   void draw(const ViewUniforms& view, const Canvas& canvas) const;
 
  private:

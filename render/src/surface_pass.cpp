@@ -43,7 +43,8 @@ SurfacePass::SurfacePass(const GlApi& gl)
       uClip_(program_.uniform("clipFromCamera")),
       uColour_(program_.uniform("colour")),
       uLighting_(program_.uniform("lighting")),
-      uGain_(program_.uniform("gain")) {
+      uGain_(program_.uniform("gain")),
+      uCutPlane_(program_.uniform("cutPlane")) {
   gl.GenVertexArrays(1, &polygonVao_);
   gl.GenBuffers(1, &polygonVbo_);
   setAttributes(gl, polygonVao_, polygonVbo_);
@@ -162,6 +163,7 @@ void SurfacePass::drawList(const std::vector<Draw>& draws, const ViewUniforms& v
   gl_.UniformMatrix4fv(uClip_, 1, GL_FALSE, view.clipFromCamera.data());
   gl_.Uniform4f(uLighting_, view.lighting[0], view.lighting[1], view.lighting[2], view.lighting[3]);
   gl_.Uniform1f(uGain_, view.gain);
+  gl_.Uniform4f(uCutPlane_, view.cutPlane[0], view.cutPlane[1], view.cutPlane[2], view.cutPlane[3]);
   for (const Draw& d : draws) {
     gl_.UniformMatrix4fv(uCameraFromModel_, 1, GL_FALSE, d.cameraFromModel.data());
     gl_.Uniform4f(uColour_, d.colour[0], d.colour[1], d.colour[2], d.colour[3]);

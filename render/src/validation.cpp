@@ -57,6 +57,11 @@ void validateFrame(const FrameDescription& frame) {
   if (!(frame.lightGain >= 0.0) || !std::isfinite(frame.lightGain))
     invalidFrame("lightGain", "must be finite and >= 0 (got " + str(frame.lightGain) + ")");
   if (!finiteColour(frame.background)) invalidFrame("background", "must be finite");
+  if (frame.cut) {
+    if (!frame.cut->point.allFinite()) invalidFrame("cut.point", "must be finite");
+    if (!frame.cut->normal.allFinite() || !(frame.cut->normal.norm() > 0.0))
+      invalidFrame("cut.normal", "must be finite and non-zero");
+  }
 }
 
 }  // namespace detail

@@ -7,8 +7,10 @@
 
 namespace rocklab::experiments::test {
 
-inline std::vector<std::string> tinyCrusherRunArgs(const std::string& out, int threads = 1) {
-  const std::string scene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/cone-crusher-pbm.toml";
+/// `scene_file`: a scene of assets/scenes/ that extends cone-crusher-pbm.toml.
+inline std::vector<std::string> tinyCrusherRunArgs(const std::string& out, int threads = 1,
+                                                   const std::string& scene_file = "cone-crusher-pbm.toml") {
+  const std::string scene = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/" + scene_file;
   std::vector<std::string> args{"run", scene, "--out", out, "--threads", std::to_string(threads), "--quiet",
                                 "--set", "crusher.release_time=0.02", "--set", "scene.end_time=2.0",
                                 "--set", "output.frame_interval=0.05"};

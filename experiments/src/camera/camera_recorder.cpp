@@ -58,6 +58,7 @@ void CameraRecorder::record(const sim::Snapshot& s, const sim::Model& model,
   const auto t0 = std::chrono::steady_clock::now();
   render::FrameDescription frame = builder_.describe(s, model, markers, frames_);
   frame.lightGain = settings_.light_gain;
+  frame.cut = settings_.cut;
   cv::Mat image = renderer_.render(frame);
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (on_frame) on_frame(frames_, s.time, image);  // its time is the tracker's, not the camera's
@@ -87,6 +88,11 @@ void CameraRecorder::finish(nlohmann::json& cameras) {
                       {"gl_version", renderer_.glVersion()},
                       {"gl_renderer", renderer_.glRenderer()},
                       {"render_s", seconds_}};
+  if (settings_.cut) {
+    const auto& p = settings_.cut->point;
+    const auto& n = settings_.cut->normal;
+    c["cut"] = {{"point_m", {p.x(), p.y(), p.z()}}, {"normal", {n.x(), n.y(), n.z()}}};
+  }
   if (movie_) {
     const std::filesystem::path path = movie_->close();
     c["movie"] = path.filename().string();

@@ -1,4 +1,5 @@
 // Scene reader: [[cameras]] (also the camera files of `rocklab render`).
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -20,6 +21,25 @@ std::string sceneKeyOf(const std::string& message) {
   for (const auto& [field, key] : fields)
     if (message.rfind(std::string(field) + " ", 0) == 0) return key;
   return "exposure";
+}
+
+/// [cameras.cut]: the cut-away plane. By default the plane through the camera's
+/// target facing the camera across `up` (a vertical plane when up is vertical),
+/// removing the half of the scene nearest the camera.
+render::CutPlane readCut(TableReader& t, const Vec3& eye, const Vec3& target, const Vec3& up) {
+  render::CutPlane cut;
+  cut.point = t.vec3("point", target);
+  const Vec3 u = up.normalized();
+  Vec3 towards = eye - cut.point;
+  towards -= towards.dot(u) * u;
+  const bool facing = towards.norm() > 1e-9 * std::max(1.0, (eye - cut.point).norm());
+  if (!t.has("normal") && !facing)
+    t.fail("normal", "is needed: the eye lies on the line through point along up, so no plane faces the camera");
+  cut.normal = t.vec3("normal", facing ? Vec3(towards.normalized()) : Vec3::UnitX());
+  if (!(cut.normal.norm() > 0)) t.fail("normal", "must be non-zero");
+  cut.normal.normalize();
+  t.finish();
+  return cut;
 }
 
 }  // namespace
@@ -59,8 +79,9 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     const Vec3 eye = t.requiredVec3("eye"), target = t.requiredVec3("target");
     // lookAt throws for either of two keys: say which.
     if (!((target - eye).norm() > 0)) t.fail("eye", "equals target: the camera must look at a point away from it");
+    const Vec3 up = t.vec3("up", Vec3::UnitZ());
     try {
-      cam.lookAt(eye, target, t.vec3("up", Vec3::UnitZ()));
+      cam.lookAt(eye, target, up);
     } catch (const std::invalid_argument& e) {
       t.fail("up", e.what());
     }
@@ -88,6 +109,7 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
                       ? ColourBy::Fragment
                       : ColourBy::Material;
     if (c.motion_blur && !(cam.exposureTime > 0)) t.fail("motion_blur", "needs exposure > 0 s");
+    if (auto cut = t.table("cut")) c.cut = readCut(*cut, eye, target, up);
     t.finish();
     cameras.push_back(c);
   }

@@ -11,6 +11,13 @@ namespace {
 
 constexpr double kMaxAngle = 90.0;
 
+// How the crusher's walls are drawn (a camera's view; [crusher] mantle_colour and
+// concave_colour): the mantle and its cap a blue steel, the concave a bronze liner,
+// the feed bin and the stop wall a dark steel, all apart from the grey rock.
+constexpr render::Rgb kMantleColour{0.30f, 0.42f, 0.62f};
+constexpr render::Rgb kConcaveColour{0.66f, 0.50f, 0.30f};
+constexpr render::Rgb kFeedWallColour{0.34f, 0.36f, 0.38f};
+
 geometry::ConeCrusherSpec readSpec(TableReader& t) {
   geometry::ConeCrusherSpec s;
   const Range open_angle{0.0, kMaxAngle, true, true};
@@ -70,7 +77,9 @@ void addFeedWalls(TableReader& t, int material, const geometry::ConeCrusherGeome
   bin.bottom_radius = bin.top_radius = radius;
   bin.segments = g.spec.segments;
   bin.facing = geometry::FrustumFacing::TowardAxis;
-  addWall(scene, material, "crusher.feed_bin", geometry::frustumMesh(bin), WallLook{});
+  WallLook bin_look;
+  bin_look.colour = kFeedWallColour;
+  addWall(scene, material, "crusher.feed_bin", geometry::frustumMesh(bin), bin_look);
   sim::Wall stop_wall;
   stop_wall.name = "crusher.stop";
   stop_wall.shape = sim::WallShape::Plane;
@@ -79,7 +88,10 @@ void addFeedWalls(TableReader& t, int material, const geometry::ConeCrusherGeome
   stop_wall.material = material;
   stop_wall.active_until = release;
   scene.model.walls.push_back(stop_wall);
-  scene.wall_looks.push_back(WallLook{});
+  WallLook stop_look = bin_look;  // drawn as a disc filling the bin, not a 2 m square over the chamber
+  stop_look.plane_disc = true;
+  stop_look.plane_size = 2.0 * radius;
+  scene.wall_looks.push_back(stop_look);
 }
 
 }  // namespace
@@ -103,6 +115,9 @@ void readCrusher(TableReader& root, const std::map<std::string, int>& materials,
   c.spin_sense = parseSpinSense(t->string("spin_sense", "opposite", {"opposite", "same", "none"}));
   c.material = materialIndex(*t, materials);
   const bool walls = t->boolean("walls", true);
+  WallLook mantle_look, concave_look;
+  mantle_look.colour = readColour(*t, "mantle_colour", kMantleColour);
+  concave_look.colour = readColour(*t, "concave_colour", kConcaveColour);
   geometry::ConeCrusherGeometry g;
   try {
     g = geometry::coneCrusherGeometry(c.spec);
@@ -111,12 +126,11 @@ void readCrusher(TableReader& root, const std::map<std::string, int>& materials,
   }
   if (walls) {
     const geometry::ConeCrusherMeshes m = geometry::coneCrusherMeshes(g);
-    const WallLook look;
     const sim::WallMotion mantle = mantleWallMotion(geometry::mantleMotion(g, c.eccentric_rpm, c.spin_sense));
-    addWall(scene, c.material, "crusher.mantle", m.mantle, look, mantle);
-    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, look, mantle);
-    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, look);
-    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, look);
+    addWall(scene, c.material, "crusher.mantle", m.mantle, mantle_look, mantle);
+    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, mantle_look, mantle);
+    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, concave_look);
+    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, concave_look);
   }
   if (t->boolean("feed_bin", false)) addFeedWalls(*t, c.material, g, scene);
   scene.crusher = c;

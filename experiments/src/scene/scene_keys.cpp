@@ -119,6 +119,8 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"crusher", "stop_height", "m", "Height of the stop wall and the feed bin's bottom (above the chamber's top).", nullptr, "10 mm above O_top_c"},
       {"crusher", "feed_bin_top", "m", "Height of the feed bin's top.", nullptr, "stop_height + 0.5 m"},
       {"crusher", "release_time", "s", "When the stop wall goes and the feed falls into the chamber."},
+      {"crusher", "mantle_colour", "", "[r, g, b] in [0, 1]: how a camera draws the mantle and its cap (the feed bin and stop wall are a dark steel)."},
+      {"crusher", "concave_colour", "", "[r, g, b] in [0, 1]: how a camera draws the lower and upper concave."},
 
       // --- [[walls]]
       {"walls", "", "", "A wall: plane, polygon, plate, mesh or box, with prescribed motion and an active time window. Keys by type are marked (plane), (polygon), ..."},
@@ -245,6 +247,9 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"cameras", "ambient", "", "Light from all sides, as a fraction of a material's colour (a sizing station's dome light: high ambient, low diffuse)."},
       {"cameras", "diffuse", "", "The lamp at the camera: diffuse fraction of a material's colour (a sphere darkens towards its outline)."},
       {"cameras", "specular", "", "The lamp's white highlight (Blinn-Phong)."},
+      {"cameras.cut", "", "", "A cut-away: what lies beyond a plane is not drawn, so the inside of a closed chamber shows. Walls are clipped per pixel (their cut edges and inner faces show); a ball is dropped whole when its centre lies beyond the plane. An empty table cuts along the vertical plane through target that faces the camera (docs/camera.md)."},
+      {"cameras.cut", "point", "m", "A point on the cut plane.", nullptr, "target"},
+      {"cameras.cut", "normal", "", "Normal of the plane, pointing into the half that is removed (any length).", nullptr, "from point towards eye, its part along up removed (the half nearest the camera goes)"},
 
       // --- [experiment]
       {"experiment", "", "", "The experiment type and the keys every type has; the other keys depend on the type (tables below)."},

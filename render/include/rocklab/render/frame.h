@@ -3,6 +3,7 @@
 // converts a simulation snapshot into one). Nothing here knows about the simulation.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "rocklab/geometry/triangle_mesh.h"
@@ -55,6 +56,16 @@ struct MeshInstance {
   float opacity = 1.0f;             // [0, 1]
 };
 
+/// A cut-away (a clip plane): what lies beyond the plane, n · (x − point) > 0, is not
+/// drawn, so the inside of a closed chamber shows. Walls (polygons and meshes, opaque
+/// and transparent) are clipped per pixel, so a cut shell shows its cut edge and its
+/// inner face; a sphere is dropped whole when its centre lies beyond the plane (a ball
+/// is shown entire or not at all, as a DEM post-processor's half-space selection).
+struct CutPlane {
+  Vec3 point = Vec3::Zero();     // m, world: a point on the plane
+  Vec3 normal = Vec3::UnitZ();   // world, any length > 0: points into the removed half-space
+};
+
 struct FrameDescription {
   std::vector<SphereInstance> spheres;
   std::vector<Polygon> polygons;
@@ -63,6 +74,7 @@ struct FrameDescription {
   double time = 0.0;         // s, middle of the exposure (overlays, motion blur)
   std::uint64_t index = 0;   // frame number: seeds the sensor noise of this frame
   double lightGain = 1.0;    // lighting change: scales every lit colour and the background
+  std::optional<CutPlane> cut;  // none: everything is drawn
 };
 
 }  // namespace rocklab::render
