@@ -119,8 +119,8 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"crusher", "stop_height", "m", "Height of the stop wall and the feed bin's bottom (above the chamber's top).", nullptr, "10 mm above O_top_c"},
       {"crusher", "feed_bin_top", "m", "Height of the feed bin's top.", nullptr, "stop_height + 0.5 m"},
       {"crusher", "release_time", "s", "When the stop wall goes and the feed falls into the chamber."},
-      {"crusher", "mantle_colour", "", "[r, g, b] in [0, 1]: how a camera draws the mantle and its cap (the feed bin and stop wall are a dark steel)."},
-      {"crusher", "concave_colour", "", "[r, g, b] in [0, 1]: how a camera draws the lower and upper concave."},
+      {"crusher", "mantle_colour", "", "Colour [r, g, b] of the mantle and its cap in images (the feed bin and the stop wall are a dark steel, [0.34, 0.36, 0.38]).", "[r, g, b], each in [0, 1]", "[0.30, 0.42, 0.62] (blue steel)"},
+      {"crusher", "concave_colour", "", "Colour [r, g, b] of the lower and upper concave in images.", "[r, g, b], each in [0, 1]", "[0.66, 0.50, 0.30] (bronze)"},
 
       // --- [[walls]]
       {"walls", "", "", "A wall: plane, polygon, plate, mesh or box, with prescribed motion and an active time window. Keys by type are marked (plane), (polygon), ..."},
