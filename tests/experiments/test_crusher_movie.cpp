@@ -101,11 +101,13 @@ TEST_CASE("crusher movie: a short crusher run with the cut-away camera writes it
           "[cli][crusher][camera][cutaway]") {
   // The tiny CI crusher run (crusher_support.h: six 8-9 mm balls, soft contacts, the
   // release at 0.02 s) on the movie scene, cut short at 0.3 s, filmed from t = 0 at
-  // 50 frames/s with a still every 0.1 s.
+  // 50 frames/s with a still every 0.1 s; the breakage's step and fragment stiffness
+  // as in the tiny breakage run (test_crusher_breakage.cpp).
   const fs::path out = test::scratchDir("crusher-movie");
   std::vector<std::string> args = test::tinyCrusherRunArgs(out.string(), 1, "cone-crusher-movie.toml");
   for (const char* s : {"scene.end_time=0.3", "cameras.chamber.start_time=0", "cameras.chamber.frame_rate=50",
-                        "cameras.chamber.still_interval=0.1"})
+                        "cameras.chamber.still_interval=0.1", "experiment.breakage.youngs_modulus=1e8",
+                        "experiment.breakage.min_diameter=0.0079", "timestep.dt=7e-7"})
     args.insert(args.end(), {"--set", s});
   REQUIRE(test::cli(args) == 0);
   std::ifstream in(out / "results.json");
