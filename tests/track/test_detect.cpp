@@ -92,6 +92,54 @@ TEST_CASE("two touching markers are split into two detections", "[track][detect]
   CHECK(detectMarkers(frame, noSplit).size() == 8);
 }
 
+TEST_CASE("markers of one size: a blob more than one covers is split whatever its fill or reported merged",
+          "[track][detect]") {
+  const double r = 8.0;
+  DetectorSettings one_size;
+  one_size.expected_area_px = std::numbers::pi * (r + 0.5) * (r + 0.5);  // the mask of one disc, antialiased rim included
+  one_size.marker_max_ratio = 1.4;
+  DetectorSettings any_size = one_size;
+  any_size.marker_max_ratio = 0.0;
+  // Two markers, one mostly behind the other (centres 0.8 r apart): about 1.5 marker
+  // areas and round (fill ~0.75); the size rule (1.8, fill < 0.8) takes it for one.
+  cv::Mat pair = greyFrame({200, 150}, 2.0, 11);
+  const cv::Point2d a(100.3, 70.4), b(a.x + 0.8 * r, a.y + 0.1);
+  for (const cv::Point2d& p : {a, b}) drawDisc(pair, p, r);
+  const std::vector<Detection> whole = detectMarkers(pair, any_size);
+  REQUIRE(whole.size() == 1);
+  CHECK_FALSE(whole[0].merged);  // off: a big blob may be one big marker
+  const std::vector<Detection> split = detectMarkers(pair, one_size);
+  REQUIRE(split.size() == 2);
+  for (const Detection& d : split) CHECK_FALSE(d.merged);
+  CHECK(std::min(split[0].centroid.x, split[1].centroid.x) < 0.5 * (a.x + b.x));
+  CHECK(std::max(split[0].centroid.x, split[1].centroid.x) > 0.5 * (a.x + b.x));
+
+  // Four markers in a row cut at two tracks' predictions: two pieces of about two
+  // markers each, more than one marker covers: merged, not one marker's position.
+  cv::Mat row = greyFrame({200, 150}, 2.0, 12);
+  std::vector<cv::Point2d> centres;
+  for (int k = 0; k < 4; ++k) centres.emplace_back(60.2 + 1.6 * r * k, 75.3);
+  for (const cv::Point2d& p : centres) drawDisc(row, p, r);
+  const std::vector<cv::Point2d> predictions{centres[0], centres[1]};
+  const std::vector<Detection> pieces = detectMarkers(row, one_size, predictions);
+  REQUIRE(pieces.size() == 2);
+  for (const Detection& d : pieces) CHECK(d.merged);
+  for (const Detection& d : detectMarkers(row, any_size, predictions)) CHECK_FALSE(d.merged);
+
+  // Off the optical axis a marker covers more (1 / cos θ): with the camera's focal
+  // length a lone marker 1.5 times the axis' area at 45° is one marker, not merged.
+  cv::Mat edge = greyFrame({200, 150}, 2.0, 13);
+  drawDisc(edge, {150.2, 75.4}, std::sqrt(1.5) * (r + 0.5) - 0.5);
+  DetectorSettings off_axis = one_size;
+  off_axis.principal_point_px = {50.0, 75.0};
+  off_axis.focal_px = 100.0;  // 100 px off the axis: θ = 45°, the reference grows by 1.41
+  const std::vector<Detection> lone = detectMarkers(edge, off_axis);
+  REQUIRE(lone.size() == 1);
+  CHECK_FALSE(lone[0].merged);
+  const std::vector<Detection> on_axis = detectMarkers(edge, one_size);
+  CHECK((on_axis.size() == 2 || (on_axis.size() == 1 && on_axis[0].merged)));  // without it: over 1.4 areas
+}
+
 TEST_CASE("slivers and specks are rejected", "[track][detect]") {
   cv::Mat frame = greyFrame({320, 240}, 2.0, 3);
   drawDisc(frame, {160.4, 120.2}, 7.0);                                           // a marker
@@ -112,4 +160,10 @@ TEST_CASE("detector settings are validated with the field named", "[track][detec
   s = {};
   s.max_area_px = 5;
   CHECK_THROWS_WITH(s.validate(), Catch::Contains("detector.max_area_px"));
+  s = {};
+  s.marker_max_ratio = 0.5;
+  CHECK_THROWS_WITH(s.validate(), Catch::Contains("detector.marker_max_ratio"));
+  s = {};
+  s.focal_px = -1.0;
+  CHECK_THROWS_WITH(s.validate(), Catch::Contains("detector.focal_px"));
 }

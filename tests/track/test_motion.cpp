@@ -147,3 +147,36 @@ TEST_CASE("travel counts from the reference time and earlier creep does not coun
   // A reference time after the last sample leaves nothing to measure.
   CHECK_FALSE(velocityOverDistance(world, time, Vec3(-1, 0, 0), distance, onset, 1.0).complete);
 }
+
+TEST_CASE("a track measured through a merged detection gives no velocity", "[track][velocity]") {
+  // Pixels along u at 500 px/s on a camera looking down at z = 0; the travel is
+  // measured in metres on that plane.
+  rocklab::geometry::Camera camera = rocklab::geometry::Camera::withFieldOfView(640, 480, 60.0);
+  camera.lookAt(Vec3(0.0, 0.0, 1.0), Vec3(0.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0));
+  Track track;
+  track.id = 7;
+  for (int k = 0; k < 200; ++k) track.points.push_back({k, k / kFrameRate, {120.0 + k, 240.0}});
+  const Vec3 along = (rocklab::track::pointToWorld(camera, track.points.back(), Vec3::Zero(), Vec3::UnitZ()).value() -
+                      rocklab::track::pointToWorld(camera, track.points.front(), Vec3::Zero(), Vec3::UnitZ()).value());
+  auto measure = [&](const Track& t) { return trackVelocity(t, camera, Vec3::Zero(), Vec3::UnitZ(), along, 0.1, 0.002, 0.01); };
+  const MarkerVelocity clean = measure(track);
+  REQUIRE(clean.complete);
+  CHECK_FALSE(clean.merged);
+  // A merged point while measured (two markers in the blob): no velocity.
+  Track during = track;
+  during.points[20].merged = true;
+  const MarkerVelocity withheld = measure(during);
+  CHECK(withheld.merged);
+  CHECK_FALSE(withheld.complete);
+  CHECK(std::isnan(withheld.velocity));
+  CHECK(withheld.track_id == 7);
+  // Before the reference time, or after the travel reached its distance: not measured, kept.
+  Track outside = track;
+  outside.points[2].merged = true;  // 4 ms, the reference is at 10 ms
+  const int last = static_cast<int>(std::ceil(clean.end_time * kFrameRate)) + 2;
+  REQUIRE(last < 200);
+  outside.points[static_cast<std::size_t>(last)].merged = true;
+  const MarkerVelocity kept = measure(outside);
+  CHECK_FALSE(kept.merged);
+  CHECK(kept.velocity == Approx(clean.velocity).epsilon(1e-12));
+}

@@ -39,6 +39,11 @@ void DetectorSettings::validate() const {
     invalid("seeded_split_ratio", "must be a finite ratio >= 1", seeded_split_ratio);
   if (!(expected_area_px >= 0.0) || !std::isfinite(expected_area_px))
     invalid("expected_area_px", "must be >= 0 px (0 = median of the frame)", expected_area_px);
+  if (!(focal_px >= 0.0) || !std::isfinite(focal_px)) invalid("focal_px", "must be >= 0 px (0 = off)", focal_px);
+  if (!std::isfinite(principal_point_px.x) || !std::isfinite(principal_point_px.y))
+    invalid("principal_point_px", "must be finite", principal_point_px.x + principal_point_px.y);
+  if (!(marker_max_ratio == 0.0 || marker_max_ratio >= 1.0) || !std::isfinite(marker_max_ratio))
+    invalid("marker_max_ratio", "must be 0 (off) or a finite ratio >= 1", marker_max_ratio);
 }
 
 namespace {
@@ -107,7 +112,6 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
   }
 
   // Predictions per component (stage 4a): which tracks expect to be in it.
-  const double marker_radius = std::sqrt(reference / std::numbers::pi);
   std::vector<std::vector<cv::Point2d>> predicted(static_cast<std::size_t>(count));
   // Within a pixel (rounding): a prediction outside the blob belongs to a marker
   // that is hidden or elsewhere, and must not cut a lone marker in two.
@@ -116,21 +120,35 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     if (const int label = labelNear(components, p - cv::Point2d(origin), reach); label > 0)
       predicted[static_cast<std::size_t>(label)].push_back(p);
 
+  // The reference at a component (its box centre): off the optical axis a marker
+  // covers 1 / cos θ times its area on the axis (with focal_px and a fixed area).
+  auto referenceAt = [&](const cv::Rect& box) {
+    if (settings.focal_px <= 0.0 || settings.expected_area_px == 0.0) return reference;
+    const cv::Point2d centre = cv::Point2d(origin) + cv::Point2d(box.x + 0.5 * (box.width - 1), box.y + 0.5 * (box.height - 1));
+    const cv::Point2d off = (centre - settings.principal_point_px) / settings.focal_px;
+    return reference * std::sqrt(1.0 + off.dot(off));
+  };
+
   std::vector<Detection> out;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const int label = candidates[c];
-    const detail::Blob blob =
-        detail::componentBlob(components, label, components.boxes[static_cast<std::size_t>(label)], origin);
+    const cv::Rect& box = components.boxes[static_cast<std::size_t>(label)];
+    const detail::Blob blob = detail::componentBlob(components, label, box, origin);
+    const double local = referenceAt(box);
+    // More than one marker can cover (markers of one size): stage 4c.
+    const double marker_max = settings.marker_max_ratio > 0 ? settings.marker_max_ratio * local
+                                                            : std::numeric_limits<double>::infinity();
     // 5. measure the whole component; 4. split it if it is touching markers
-    // (large and not round), measuring each piece; 6. filter.
+    // (large and not round, or more than one marker covers), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};
     const std::vector<cv::Point2d>& seeds = predicted[static_cast<std::size_t>(label)];
     std::vector<detail::Blob> pieces;
-    if (seeds.size() >= 2 && areas[c] > settings.seeded_split_ratio * reference) {
+    if (seeds.size() >= 2 && areas[c] > settings.seeded_split_ratio * local) {
       pieces = detail::splitBlobAt(blob, seeds);
-    } else if (areas[c] > settings.split_ratio * reference && found[0].fill < settings.split_max_fill) {
-      const int k = std::max(2, static_cast<int>(std::lround(areas[c] / reference)));
-      pieces = detail::splitBlob(blob, k, marker_radius);
+    } else if ((areas[c] > settings.split_ratio * local && found[0].fill < settings.split_max_fill) ||
+               areas[c] > marker_max) {
+      const int k = std::max(2, static_cast<int>(std::lround(areas[c] / local)));
+      pieces = detail::splitBlob(blob, k, std::sqrt(local / std::numbers::pi));
     }
     if (pieces.size() > 1) {
       found.clear();
@@ -141,9 +159,10 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     } else if (settings.edge_points) {
       found[0].edge_points = detail::blobEdges(bgr, blob);
     }
-    for (const Detection& d : found) {
+    for (Detection& d : found) {
       if (d.area_px < settings.min_area_px || d.area_px > settings.max_area_px) continue;
       if (d.fill < settings.min_fill) continue;
+      d.merged = d.area_px > marker_max;
       out.push_back(d);
     }
   }

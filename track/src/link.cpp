@@ -124,6 +124,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     }
     const cv::Point2d at = detections[match[i]].centroid;
     tracks_[active_[i]].points.push_back({frame, time, at, at});
+    tracks_[active_[i]].points.back().merged = detections[match[i]].merged;
     used[match[i]] = 1;
     last_track_ids_[static_cast<std::size_t>(match[i])] = active_[i];
   }
@@ -134,6 +135,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
     const int id = static_cast<int>(tracks_.size());
     const cv::Point2d at = detections[j].centroid;
     tracks_.push_back({id, {{frame, time, at, at}}});
+    tracks_.back().points.back().merged = detections[j].merged;
     active_.push_back(id);
     last_track_ids_[static_cast<std::size_t>(j)] = id;
   }

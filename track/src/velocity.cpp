@@ -101,6 +101,18 @@ MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera,
   } else {
     out = velocityOverDistance(world, time, direction, distance, onset, reference_time);
   }
+  // Points the measurement used: from the last one at or before the reference time
+  // (interpolated from) to the first at or after the end of the travel.
+  const std::vector<TrackPoint>& p = track.points;
+  for (std::size_t k = 0; k < p.size() && !out.merged; ++k) {
+    if (k + 1 < p.size() && p[k + 1].time <= reference_time) continue;  // before the reference
+    if (out.complete && k > 0 && p[k - 1].time >= out.end_time) break;  // after the end
+    out.merged = p[k].merged;
+  }
+  if (out.merged) {
+    out.velocity = std::numeric_limits<double>::quiet_NaN();
+    out.complete = false;
+  }
   out.track_id = track.id;
   return out;
 }

@@ -28,6 +28,16 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   // 16 unresolved; at 1.3-1.5: 20 of 20, 26 tracks, 7 unresolved; at 1.6 the same markers).
   constexpr double kSeededSplitAreas = 1.4;
   s.detector.seeded_split_ratio = kSeededSplitAreas;
+  // The same bound decides without predictions (issue 25): a blob over it is more
+  // than one marker can cover and is split by size whatever its fill (the area
+  // rule's 1.8 missed a pair of touching markers whose noisy mask covered 1.75 discs
+  // at sensor noise 15, fill 0.40, so one track started on both); one that cannot be
+  // split is reported merged and gives no velocity. The disc's area holds on the
+  // optical axis and grows off it as a ball's image does (1 / cos θ: 1.15 at the
+  // demo's left edge, where a lone marker covered 1.39 discs).
+  s.detector.marker_max_ratio = kSeededSplitAreas;
+  s.detector.focal_px = 0.5 * (camera_.fx + camera_.fy);
+  s.detector.principal_point_px = {camera_.cx, camera_.cy};
   // Gate: what a marker can move between two frames beyond the constant-velocity
   // prediction (up to kMaxSpeed for one frame) plus centroid jitter (up to a radius:
   // the visible part of a clump changes as it turns), so a track does not jump to a

@@ -1,11 +1,30 @@
 #include "analysis/tracking_report.h"
 
+#include <algorithm>
 #include <string>
 
 #include "analysis/plot.h"
 #include "rocklab/track/export.h"
 
 namespace rocklab::experiments {
+
+namespace {
+
+// Tracks with a point on a merged detection (two or more markers in one blob), each
+// with whether its velocity was withheld for it (the merged point was measured).
+nlohmann::json mergedTracks(const MarkerTracking::Result& result) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < result.tracks.size(); ++k) {
+    const track::Track& t = result.tracks[k];
+    const auto points = std::count_if(t.points.begin(), t.points.end(), [](const track::TrackPoint& p) { return p.merged; });
+    if (points == 0) continue;
+    const bool withheld = k < result.velocities.size() && result.velocities[k].merged;
+    out.push_back({{"track", t.id}, {"merged_points", points}, {"velocity_withheld", withheld}});
+  }
+  return out;
+}
+
+}  // namespace
 
 void MarkerTruth::add(std::size_t marker, double time, const geometry::Vec3& centre) {
   samples_.at(marker).emplace_back(time, centre);
@@ -84,7 +103,8 @@ nlohmann::json trackingErrorReport(const MarkerTracking& tracking, const MarkerT
                        {"ambiguity_ratio", s.stitch.ambiguity_ratio}}},
       {"link_gate", {{"max_distance_px", s.link.max_distance_px}, {"max_missed_frames", s.link.max_missed_frames}}},
       {"stitched", joins},
-      {"unresolved_tracks", result.unresolved}};
+      {"unresolved_tracks", result.unresolved},
+      {"merged_tracks", mergedTracks(result)}};
 
   PlotSpec plot;
   plot.title = "pixel locking: " + std::to_string(e.pairs) + " tracked positions";

@@ -12,7 +12,10 @@
 //   2. components — 8-connected components with their pixel counts, from the runs
 //                   of mask pixels (a mostly empty mask costs little);
 //   3. reference  — the area of one marker: expected_area_px, or (0) the median
-//                   area of this frame's components;
+//                   area of this frame's components; with focal_px, expected_area_px
+//                   is the area on the optical axis and grows off it as 1 / cos θ
+//                   (a ball's image at the same depth), θ the angle of the
+//                   component's box centre from the axis;
 //   4. split      — (a) prediction-seeded: a component into which two or more of the
 //                   given predictions fall (the pixel under the prediction or one of
 //                   its 8 neighbours) and larger
@@ -28,6 +31,11 @@
 //                   of one marker radius), refined by k-means (Lloyd) on the
 //                   pixel coordinates; a pixel belongs to the nearest piece centre,
 //                   so two equal touching discs are cut along their bisector;
+//                   (c) with marker_max_ratio (markers all of one size): a component
+//                   larger than marker_max_ratio × reference is more than one marker
+//                   can cover and is split by size as in (b) whatever its fill; a piece
+//                   still that large (a round pair, or no second peak) is reported
+//                   `merged`, never as one marker;
 //   5. measure    — centroid weighted by the redness w = max(0, r − max(g, b)) over
 //                   the piece and a one-pixel rim around it (the antialiased edge
 //                   that missed the thresholds), so it is sub-pixel;
@@ -45,6 +53,9 @@ struct Detection {
   double area_px = 0;    // px², pixels of the (opened) mask in this marker
   double radius_px = 0;  // px, equivalent radius √(area / π)
   double fill = 0;       // area / area of the smallest enclosing circle [-]: 1 for a disc, ½ for two touching discs
+  // More than one marker can cover (DetectorSettings::marker_max_ratio) and not cut
+  // apart: two or more markers in one detection, whose centroid is none of theirs.
+  bool merged = false;
   std::vector<cv::Point2f> edge_points;  // px, sub-pixel outline (only with DetectorSettings::edge_points)
 };
 
@@ -73,6 +84,17 @@ struct DetectorSettings {
   // Area of one marker [px²]; 0 = the median component area of each frame (needs
   // a frame with mostly single markers; with one component nothing is ever split).
   double expected_area_px = 0.0;
+  // With expected_area_px: the camera's focal length and principal point [px]; the
+  // expected area then holds on the optical axis and grows off it as 1 / cos θ
+  // (a marker at the image's edge covers more pixels than one at its centre).
+  // 0 = the same everywhere.
+  double focal_px = 0.0;
+  cv::Point2d principal_point_px{0.0, 0.0};
+  // Markers all of one size: the largest area one marker can cover, × the reference
+  // [-]. A component above it holds two or more markers: split by size whatever its
+  // fill (stage 4c), and a detection still above it after splitting is `merged`.
+  // 0 = off (markers of any size; a big round blob is one big marker).
+  double marker_max_ratio = 0.0;
   // Stage 5b: also give each detection the sub-pixel points of its outline (its
   // core pixels' steps to the unthresholded rim, placed by the two pixels'
   // redness), for the model-based position (shape_fit.h). Off: nothing is spent.

@@ -41,6 +41,7 @@ struct TrackPoint {
   // m, world: the marker's centre when the shape fit gave it (its depth from the
   // clump touching the wall); NaN = not fitted (pixel → world on the marker plane).
   geometry::Vec3 centre = geometry::Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  bool merged = false;  // the detection held two or more markers (Detection::merged)
 };
 
 struct Track {

@@ -29,6 +29,10 @@ struct MarkerVelocity {
   double end_time = 0.0;    // s, NaN if it never reached distance
   double velocity = 0.0;    // m/s (or px/s for pixel points), NaN unless complete
   bool complete = false;    // the travel reached distance
+  // trackVelocity: a point the measurement used (from the one before the reference
+  // time to the end of the travel) was a merged detection (two or more markers in
+  // one blob): the travel is not one marker's, velocity NaN and not complete.
+  bool merged = false;
 };
 
 /// `world` and `time` have equal, non-zero length (std::invalid_argument otherwise);
@@ -41,7 +45,8 @@ MarkerVelocity velocityOverDistance(const std::vector<geometry::Vec3>& world, co
 /// The same for a track: each point is taken to the world (pointToWorld: its fitted
 /// centre, else its pixel on the plane); points
 /// whose ray misses the plane are skipped (none left: incomplete, every field NaN).
-/// track_id is the track's.
+/// A track that was on a merged detection (TrackPoint::merged) while measured gives
+/// no velocity (MarkerVelocity::merged). track_id is the track's.
 MarkerVelocity trackVelocity(const Track& track, const geometry::Camera& camera, const geometry::Vec3& plane_point,
                              const geometry::Vec3& plane_normal, const geometry::Vec3& direction, double distance,
                              double onset, double reference_time = std::numeric_limits<double>::quiet_NaN());
