@@ -16,6 +16,18 @@ using rocklab::test::CameraPose;
 using rocklab::test::kSceneView;
 using rocklab::test::labCamera;
 
+/// The lab camera's scene view at a small size: focal length 1.25 × width, principal
+/// point at the image centre.
+inline Camera smallSceneCamera(int width, int height) {
+  Camera c = labCamera(kSceneView);
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = 1.25 * width;
+  c.cx = 0.5 * (width - 1);
+  c.cy = 0.5 * (height - 1);
+  return c;
+}
+
 /// A box mesh [lo, hi] (12 triangles).
 inline std::shared_ptr<const geometry::TriangleMesh> boxMesh(const Vec3& lo, const Vec3& hi) {
   auto m = std::make_shared<geometry::TriangleMesh>();

@@ -90,21 +90,11 @@ Comparison compare(const cv::Mat& image, const Camera& camera, const std::option
   return c;
 }
 
-Camera smallSceneCamera() {
-  Camera c = labCamera(kSceneView);
-  c.width = 320;
-  c.height = 240;
-  c.fx = c.fy = 400.0;
-  c.cx = 159.5;
-  c.cy = 119.5;
-  return c;
-}
-
 }  // namespace
 
 TEST_CASE("a cut-away removes the walls beyond its plane, pixel for pixel as a ray cast, and shows their inner faces",
           "[render][cutaway]") {
-  const Camera camera = smallSceneCamera();
+  const Camera camera = smallSceneCamera(320, 240);
   Renderer renderer(camera);
   FrameDescription frame = boxScene();
 
@@ -147,7 +137,7 @@ TEST_CASE("a cut-away removes the walls beyond its plane, pixel for pixel as a r
 }
 
 TEST_CASE("a cut-away drops the spheres whose centre lies beyond the plane and shows what they hid", "[render][cutaway]") {
-  const Camera camera = smallSceneCamera();
+  const Camera camera = smallSceneCamera(320, 240);
   const Vec3 eye = camera.position();
   const Vec3 view = (Vec3(0.0, 0.0, 0.05) - eye).normalized();
   // A near red sphere wholly hiding a smaller far blue one on the same line of sight
@@ -203,7 +193,7 @@ TEST_CASE("a cut-away drops the spheres whose centre lies beyond the plane and s
 }
 
 TEST_CASE("a cut-away with a zero or non-finite normal is refused", "[render][cutaway]") {
-  Renderer renderer(smallSceneCamera());
+  Renderer renderer(smallSceneCamera(320, 240));
   FrameDescription frame = boxScene();
   frame.cut = CutPlane{Vec3::Zero(), Vec3::Zero()};
   CHECK_THROWS_WITH(renderer.render(frame), Catch::Contains("frame.cut.normal"));

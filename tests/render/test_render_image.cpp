@@ -24,16 +24,6 @@ using namespace rocklab::render::test;
 
 namespace {
 
-Camera smallCamera() {
-  Camera c = labCamera(kSceneView);
-  c.width = 160;
-  c.height = 120;
-  c.fx = c.fy = 200.0;
-  c.cx = 79.5;
-  c.cy = 59.5;
-  return c;
-}
-
 std::string invalidMessage(const auto& make) {
   try {
     make();
@@ -48,7 +38,7 @@ std::string invalidMessage(const auto& make) {
 TEST_CASE("no GL context exists before a Renderer and none after it", "[render]") {
   CHECK(liveGlContexts() == 0);
   {
-    Renderer renderer(smallCamera());
+    Renderer renderer(smallSceneCamera(160, 120));
     CHECK(liveGlContexts() == 1);
     std::printf("GL_VERSION %s | GL_RENDERER %s | core profile %s\n", renderer.glVersion().c_str(),
                 renderer.glRenderer().c_str(), renderer.coreProfile() ? "yes" : "no (compatibility fallback)");
@@ -110,7 +100,7 @@ TEST_CASE("two renders of the same frame are bitwise identical", "[render]") {
 }
 
 TEST_CASE("golden image of a tiny scene", "[render][golden]") {
-  Renderer renderer(smallCamera());
+  Renderer renderer(smallSceneCamera(160, 120));
   const cv::Mat image = renderer.render(tinyScene());
   const std::filesystem::path golden = std::filesystem::path(ROCKLAB_SOURCE_DIR) / "tests/render/golden/tiny_scene.png";
   if (const char* update = std::getenv("ROCKLAB_UPDATE_GOLDEN"); update && std::string(update) == "1") {
@@ -136,7 +126,7 @@ TEST_CASE("golden image of a tiny scene", "[render][golden]") {
   cv::reduce(diff.reshape(1, diff.rows * diff.cols), worst, 1, cv::REDUCE_MAX);
   CHECK(cv::countNonZero(worst > 24) <= 20);
   // Per sphere: the pixel at its centre keeps its colour within 12 grey levels.
-  const Camera camera = smallCamera();
+  const Camera camera = smallSceneCamera(160, 120);
   for (const auto& sphere : tinyScene().spheres) {
     const Vec2 px = camera.project(sphere.centre);
     const cv::Point at(static_cast<int>(std::lround(px.x())), static_cast<int>(std::lround(px.y())));
@@ -150,7 +140,7 @@ TEST_CASE("golden image of a tiny scene", "[render][golden]") {
 TEST_CASE("the compatibility fallback draws the same image as the core profile", "[render]") {
   RenderOptions compat;
   compat.profile = GlProfile::Compatibility;
-  Renderer core(smallCamera()), fallback(smallCamera(), compat);
+  Renderer core(smallSceneCamera(160, 120)), fallback(smallSceneCamera(160, 120), compat);
   CHECK_FALSE(fallback.coreProfile());
   std::printf("fallback GL_VERSION %s\n", fallback.glVersion().c_str());
   CHECK(cv::norm(core.render(tinyScene()), fallback.render(tinyScene()), cv::NORM_INF) == 0);
@@ -192,7 +182,7 @@ TEST_CASE("sensor noise is seeded by the frame index and has the asked sigma", "
   RenderOptions noisy;
   noisy.noiseSigma = 4.0;
   noisy.noiseSeed = 7;
-  Renderer clean(smallCamera()), sensor(smallCamera(), noisy);
+  Renderer clean(smallSceneCamera(160, 120)), sensor(smallSceneCamera(160, 120), noisy);
   FrameDescription frame = tinyScene();
   const cv::Mat reference = clean.render(frame);
   frame.index = 3;
@@ -211,7 +201,7 @@ TEST_CASE("sensor noise is seeded by the frame index and has the asked sigma", "
 }
 
 TEST_CASE("light gain scales the background and the lit colours", "[render]") {
-  Renderer renderer(smallCamera());
+  Renderer renderer(smallSceneCamera(160, 120));
   FrameDescription frame;
   frame.background = {0.2f, 0.4f, 0.6f};
   frame.lightGain = 0.5;
@@ -222,21 +212,21 @@ TEST_CASE("light gain scales the background and the lit colours", "[render]") {
 
 TEST_CASE("bad input throws std::invalid_argument naming the field", "[render]") {
   using Catch::Matchers::StartsWith;
-  Camera noFocal = smallCamera();
+  Camera noFocal = smallSceneCamera(160, 120);
   noFocal.fx = 0;
   CHECK_THAT(invalidMessage([&] { Renderer r(noFocal); }), StartsWith("camera.fx"));
-  Camera empty = smallCamera();
+  Camera empty = smallSceneCamera(160, 120);
   empty.height = 0;
   CHECK_THAT(invalidMessage([&] { Renderer r(empty); }), StartsWith("camera.height"));
-  Camera skew = smallCamera();
+  Camera skew = smallSceneCamera(160, 120);
   skew.rotation(0, 0) *= 1.01;
   CHECK_THAT(invalidMessage([&] { Renderer r(skew); }), StartsWith("camera.rotation"));
   RenderOptions options;
   options.farClip = options.nearClip;
-  CHECK_THAT(invalidMessage([&] { Renderer r(smallCamera(), options); }), StartsWith("render options.farClip"));
+  CHECK_THAT(invalidMessage([&] { Renderer r(smallSceneCamera(160, 120), options); }), StartsWith("render options.farClip"));
   CHECK(liveGlContexts() == 0);  // nothing was created for invalid input
 
-  Renderer renderer(smallCamera());
+  Renderer renderer(smallSceneCamera(160, 120));
   FrameDescription frame = tinyScene();
   frame.spheres[2].radius = -1;
   CHECK_THAT(invalidMessage([&] { renderer.render(frame); }), StartsWith("frame.spheres[2].radius"));
@@ -247,14 +237,14 @@ TEST_CASE("bad input throws std::invalid_argument naming the field", "[render]")
 }
 
 TEST_CASE("the cached wall layer follows wall and camera changes", "[render]") {
-  Renderer renderer(smallCamera());
+  Renderer renderer(smallSceneCamera(160, 120));
   FrameDescription frame = tinyScene();
   (void)renderer.render(frame);
   frame.polygons[0].colour = {0.7f, 0.2f, 0.2f};
   frame.meshes[0].translation = Vec3(-0.02, 0.0, 0.0);
   frame.background = {0.3f, 0.3f, 0.1f};
-  CHECK(cv::norm(renderer.render(frame), Renderer(smallCamera()).render(frame), cv::NORM_INF) == 0);
-  Camera moved = smallCamera();
+  CHECK(cv::norm(renderer.render(frame), Renderer(smallSceneCamera(160, 120)).render(frame), cv::NORM_INF) == 0);
+  Camera moved = smallSceneCamera(160, 120);
   moved.lookAt(Vec3(0.15, -0.5, 0.3), Vec3(0.0, 0.0, 0.03), Vec3(0, 0, 1));
   renderer.setCamera(moved);
   CHECK(cv::norm(renderer.render(frame), Renderer(moved).render(frame), cv::NORM_INF) == 0);

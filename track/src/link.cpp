@@ -103,6 +103,11 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
   // 5. update: matched tracks grow, the other detections start tracks; a track
   // whose match is not clearly its nearest detection ends.
   std::vector<char> used(m, 0), closed(n, 0);
+  auto pointOf = [&](const Detection& d) {
+    TrackPoint point{frame, time, d.centroid, d.centroid};
+    point.merged = d.merged;
+    return point;
+  };
   const double ratio2 = settings_.ambiguity_ratio * settings_.ambiguity_ratio;
   for (int i = 0; i < n; ++i) {
     if (match[i] < 0) continue;
@@ -122,9 +127,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
         continue;
       }
     }
-    const cv::Point2d at = detections[match[i]].centroid;
-    tracks_[active_[i]].points.push_back({frame, time, at, at});
-    tracks_[active_[i]].points.back().merged = detections[match[i]].merged;
+    tracks_[active_[i]].points.push_back(pointOf(detections[match[i]]));
     used[match[i]] = 1;
     last_track_ids_[static_cast<std::size_t>(match[i])] = active_[i];
   }
@@ -133,9 +136,7 @@ void Linker::add(int frame, double time, const std::vector<Detection>& detection
   for (int j = 0; j < m; ++j) {
     if (used[j]) continue;
     const int id = static_cast<int>(tracks_.size());
-    const cv::Point2d at = detections[j].centroid;
-    tracks_.push_back({id, {{frame, time, at, at}}});
-    tracks_.back().points.back().merged = detections[j].merged;
+    tracks_.push_back({id, {pointOf(detections[j])}});
     active_.push_back(id);
     last_track_ids_[static_cast<std::size_t>(j)] = id;
   }
