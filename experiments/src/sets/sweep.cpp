@@ -38,6 +38,9 @@ std::vector<std::string> defaultMetrics(const Scene& scene) {
   if (type == "zwick")
     m = {"strength_MPa", "peak_force_N", "zwick.platen_gap_at_peak_m", "zwick.load_imbalance_loading",
          "bonds_broken", "sphere_count", "bond_count", "porosity", "coordination_number"};
+  if (type == "crusher")  // the §g.9 studies' figures; the product curves are plotted beside (below)
+    m = {"crusher.p50_mm", "crusher.p80_mm", "crusher.throughput_tph", "crusher.power_W", "crusher.breakages",
+         "crusher.empty", "crusher.discharged_mass_kg", "crusher.in_chamber_mass_kg"};
   m.push_back("simulated_time_s");
   m.push_back("wall_time_s.total");
   return m;
@@ -86,11 +89,51 @@ std::pair<std::string, std::vector<std::string>> parseVary(const std::string& as
 
 namespace {
 
+/// Crusher sweeps (the reference's studies, experiments.md §g.9, report a product
+/// curve per case): every run's cumulative passing on one sieve chart,
+/// product_curves.png, labelled by its varied values, with the first run's feed.
+/// A run whose chamber was not empty at its end is labelled so: its curve is the
+/// product discharged so far. Nothing is drawn when no run has a product curve.
+void writeProductCurves(const std::filesystem::path& dir, const SweepOptions& o, const std::vector<Variant>& done,
+                        const std::string& name, std::ostream& log) {
+  PlotSpec spec = sieveChart(name + ": product size distribution of each run");
+  auto curve = [](const json& psd, PlotSeries& s) {
+    for (const json& row : psd) {
+      s.x.push_back(number(row.value("size_mm", json())));
+      s.y.push_back(100 * number(row.value("passing", json())));
+    }
+  };
+  for (const Variant& p : done) {
+    const json psd = lookup(p.results, "crusher.psd");
+    if (!psd.is_array() || psd.empty()) continue;
+    if (spec.series.empty())
+      if (const json feed = lookup(p.results, "crusher.feed_psd"); feed.is_array() && !feed.empty()) {
+        PlotSeries f{"feed", {}, {}, PlotSeries::Style::Line};
+        curve(feed, f);
+        spec.series.push_back(f);
+      }
+    PlotSeries s;
+    for (std::size_t k = 0; k < o.vary.size(); ++k)
+      s.label += (k > 0 ? ", " : "") + o.vary[k].first + " = " + p.values[k];
+    if (lookup(p.results, "crusher.empty") != json(true)) s.label += " (chamber not empty)";
+    curve(psd, s);
+    spec.series.push_back(s);
+  }
+  if (spec.series.size() < 2) return;  // no product curve (at most the feed)
+  try {
+    writePlot(spec, dir / "product_curves.png");
+    log << "sweep: product curves " << (dir / "product_curves.png").string() << "\n";
+  } catch (const std::exception& e) {
+    log << "sweep: no product curves (" << e.what() << ")\n";
+  }
+}
+
 /// The sweep's table and plot from what its runs left (inspectRuns: in-process,
 /// processes or collect).
 int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const std::vector<std::string>& metrics,
                 const std::vector<Variant>& done, const std::string& name, std::ostream& log) {
   writeMetricTable(o, metrics, done, dir / "sweep.csv", log);
+  writeProductCurves(dir, o, done, name, log);
   // Plot: the first metric against the first key; one series per value of the second key.
   PlotSpec spec;
   spec.title = name + ": " + metrics.front() + " against " + o.vary.front().first;
