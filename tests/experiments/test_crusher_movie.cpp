@@ -1,6 +1,11 @@
 // The crusher's cut-away movie (issue 21): [cameras.cut] read from the scene, the
-// chamber's walls drawn cut, and a short crusher run with the camera writing frames.
+// chamber's walls drawn cut, a short crusher run with the camera writing frames,
+// and `rocklab render` of a breakage run's run.h5 (its fragments' materials).
+#include <H5Cpp.h>
+
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -12,6 +17,7 @@
 #include "crusher_support.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/render/renderer.h"
+#include "rocklab/sim/output/run_file.h"
 
 namespace fs = std::filesystem;
 using namespace rocklab;
@@ -127,5 +133,109 @@ TEST_CASE("crusher movie: a short crusher run with the cut-away camera writes it
   CHECK(still.cols == 640);
   CHECK(pixelsOfHue(still, kMantle) > 5000);
   CHECK(pixelsOfHue(still, kConcave) > 5000);
+  fs::remove_all(out);
+}
+
+TEST_CASE("crusher movie: rocklab render of a breakage run draws its stored frames as the run did, fragments in "
+          "their feed's shade, and an old run.h5 without /materials is refused naming the file",
+          "[cli][crusher][camera][cutaway][breakage]") {
+  // The tiny breakage run (test_crusher_breakage.cpp: weak balls that break by 0.17 s)
+  // on the movie scene to 0.25 s. The camera films every stored frame: 20 frames/s
+  // and a frame every 0.05 s, at a step (0.5 us) that divides it, so the camera's
+  // frames and the stored ones are the same steps (at another step they can be a
+  // step apart, and differ by that step's motion). Every raw frame is written.
+  const fs::path out = test::scratchDir("crusher-rerender");
+  std::vector<std::string> args = test::tinyCrusherRunArgs(out.string(), 1, "cone-crusher-movie.toml");
+  for (const char* s : {"scene.end_time=0.25", "experiment.breakage.q_ref=2e5",
+                        "experiment.breakage.check_interval=2e-5", "experiment.breakage.youngs_modulus=1e8", "experiment.breakage.min_diameter=0.0079",
+                        "timestep.dt=5e-7", "output.vtk=false", "cameras.chamber.start_time=0",
+                        "cameras.chamber.frame_rate=20", "cameras.chamber.all_frames=true",
+                        "cameras.chamber.resolution=[320,240]", "cameras.chamber.movie=false"})
+    args.insert(args.end(), {"--set", s});
+  REQUIRE(test::cli(args) == 0);
+  std::ifstream in(out / "results.json");
+  const auto r = nlohmann::json::parse(in);
+  REQUIRE(r["crusher"]["breakage"]["events"].get<int>() >= 1);
+  const int live_frames = r["cameras"][0]["frames"].get<int>();
+  CHECK(live_frames == 5);  // t = 0, 0.05, ..., 0.2 (the run's last step, 0.25 s - dt, is not due)
+
+  // The run stored the fragment classes it made, each made from its feed material.
+  const Scene scene = loadScene(kMovieScene);
+  const std::size_t own = scene.model.materials.size();
+  std::size_t fragment_frames = 0;
+  {
+    sim::output::RunFileReader run(out / "run.h5");
+    const auto& materials = run.materials();
+    REQUIRE(materials.size() > own);
+    for (std::size_t m = own; m < materials.size(); ++m) {
+      CHECK(materials[m].made_from >= 0);
+      CHECK(static_cast<std::size_t>(materials[m].made_from) < own);
+    }
+    // Drawn as the run drew them: in the colour of the material they were made from.
+    sim::Model model = scene.model;
+    model.materials = materials;
+    const FrameBuilder builder(scene);
+    for (std::size_t k = 0; k < run.frameCount(); ++k) {
+      const sim::Snapshot& s = run.frame(k);
+      const auto spheres = builder.describe(s, model, {}, k).spheres;
+      bool fragments = false;
+      for (std::size_t i = 0; i < s.material.size(); ++i) {
+        const auto m = static_cast<std::size_t>(s.material[i]);
+        if (m < own) continue;
+        fragments = true;
+        const render::Rgb feed = scene.material_colours[static_cast<std::size_t>(materials[m].made_from)];
+        CHECK((spheres[i].colour.r == feed.r && spheres[i].colour.g == feed.g && spheres[i].colour.b == feed.b));
+      }
+      fragment_frames += fragments;
+    }
+  }
+  REQUIRE(fragment_frames >= 1);
+
+  // The re-render: every frame the run's camera drew, pixel for pixel.
+  std::string log;
+  REQUIRE(test::cliLogged({"render", (out / "run.h5").string(), "--out", (out / "render").string()}, log) == 0);
+  INFO(log);
+  for (int k = 0; k < live_frames; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06d.png", k);
+    INFO(name);
+    const cv::Mat live = cv::imread((out / "frames" / "chamber" / name).string());
+    const cv::Mat again = cv::imread((out / "render" / "frames" / "chamber" / name).string());
+    REQUIRE_FALSE(live.empty());
+    REQUIRE(again.size() == live.size());
+    CHECK(cv::norm(live, again, cv::NORM_INF) == 0);
+  }
+
+  // A file from before /materials (the same run without it) is refused with the file
+  // and what it lacks, exit 2; its frames before the first breakage still render.
+  const fs::path old = out / "old" / "run.h5";
+  fs::create_directories(old.parent_path());
+  fs::copy_file(out / "run.h5", old);
+  H5::H5File(old.string(), H5F_ACC_RDWR).unlink("materials");
+  CHECK(sim::output::RunFileReader(old).materials().empty());
+  CHECK(test::cliLogged({"render", old.string()}, log) == 2);
+  CHECK_THAT(log, Contains(old.string()) && Contains("material row") && Contains("no /materials") &&
+                      Contains("Run the scene again"));
+  CHECK_FALSE(fs::exists(old.parent_path() / "chamber_still_000000.png"));  // nothing written
+  {
+    std::vector<std::string> with_fragments;
+    {
+      sim::output::RunFileReader run(old);
+      for (std::size_t k = 0; k < run.frameCount(); ++k) {
+        const auto& m = run.frame(k).material;
+        if (std::any_of(m.begin(), m.end(), [&](std::int32_t x) { return static_cast<std::size_t>(x) >= own; })) {
+          char name[32];
+          std::snprintf(name, sizeof name, "%06zu", k);
+          with_fragments.push_back(name);
+        }
+      }
+    }
+    H5::H5File file(old.string(), H5F_ACC_RDWR);
+    for (const std::string& name : with_fragments) file.openGroup("frames").unlink(name);
+  }
+  CHECK(test::cliLogged({"render", old.string()}, log) == 0);
+  const cv::Mat first = cv::imread((old.parent_path() / "frames" / "chamber" / "frame_000000.png").string());
+  REQUIRE_FALSE(first.empty());
+  CHECK(cv::norm(first, cv::imread((out / "frames" / "chamber" / "frame_000000.png").string()), cv::NORM_INF) == 0);
   fs::remove_all(out);
 }

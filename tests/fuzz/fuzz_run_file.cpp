@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "camera/frame_builder.h"
+#include "camera/render_run.h"
 #include "fuzz_support.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/sim/output/run_file.h"
@@ -15,7 +16,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto file = fuzz::patchedTemplate("run.h5", data, size);
   try {
     sim::output::RunFileReader run(file);
-    const experiments::Scene scene = experiments::loadSceneText(run.sceneText(), file.string() + ":/scene", {}, {});
+    experiments::Scene scene = experiments::loadSceneText(run.sceneText(), file.string() + ":/scene", {}, {});
+    if (!experiments::addRunMaterials(run.materials(), scene.model).empty()) return 0;  // render: exit 2
     const experiments::FrameBuilder builder(scene);
     for (std::size_t k = 0; k < run.frameCount(); ++k) (void)builder.describe(run.frame(k), scene.model, {}, k);
   } catch (const std::exception&) {

@@ -431,6 +431,100 @@ TEST_CASE("output: bad bond datasets in a run file are refused with file, datase
   CHECK(run.frameCount() == 0);
 }
 
+TEST_CASE("output: run file materials table: a frame's new rows go with it, a killed run's .partial keeps them",
+          "[output][materials]") {
+  H5::Exception::dontPrint();
+  TempDir dir;
+  const fs::path path = dir / "run.h5";
+  // The scene's two materials, then a fragment class made from the first during the run.
+  rocklab::sim::Material rock, steel, fragments;
+  rock.name = "rock";
+  rock.kn = 2e7;
+  steel.name = "steel";
+  steel.density = 7800.0;
+  fragments = rock;
+  fragments.name = "rock fragments 8-10 mm";
+  fragments.kn = 1.25e6;
+  fragments.shear_modulus = 3.5e9;
+  fragments.made_from = 0;
+  const std::vector<rocklab::sim::Material> scene{rock, steel}, grown{rock, steel, fragments};
+  const std::vector<Frame> frames{{3, 0.0, 0}, {3, 0.1, 10}};
+  {
+    output::RunFile run(path, kScene);
+    run.writeFrame(frames[0].snapshot(), scene);
+    run.writeFrame(frames[1].snapshot(), grown);
+  }  // no close(): as when a run dies with an exception
+  REQUIRE(fs::exists(partialOf(path)));
+  {
+    const H5::H5File file(partialOf(path).string(), H5F_ACC_RDONLY);
+    REQUIRE(file.openGroup("materials").getNumObjs() == 3);
+    const H5::Group row = file.openGroup("materials/000002");
+    CHECK(readText(row, "name") == "rock fragments 8-10 mm");
+    CHECK(readValues<std::int32_t>(row, "made_from", H5::PredType::NATIVE_INT32) == std::vector<std::int32_t>{0});
+    CHECK(stringAttribute(row.openDataSet("properties"), "unit") == "kg/m^3, N/m, N/m, -, Pa, -");
+  }
+  output::RunFileReader reader(partialOf(path));
+  const auto& read = reader.materials();
+  REQUIRE(read.size() == 3);
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("row " << k);
+    CHECK(read[k].name == grown[k].name);
+    CHECK(read[k].density == grown[k].density);
+    CHECK(read[k].kn == grown[k].kn);
+    CHECK(read[k].ks == grown[k].ks);
+    CHECK(read[k].friction == grown[k].friction);
+    CHECK(read[k].shear_modulus == grown[k].shear_modulus);
+    CHECK(read[k].poisson == grown[k].poisson);
+    CHECK(read[k].made_from == grown[k].made_from);
+  }
+  CHECK(reader.frameCount() == 2);
+
+  // A writer that passes no table (and every file from before it) has none.
+  {
+    output::RunFile run(dir / "plain.h5", kScene);
+    run.writeFrame(frames[0].snapshot());
+    run.close(false);
+  }
+  CHECK(output::RunFileReader(dir / "plain.h5").materials().empty());
+
+  // Rows are only added, and made from an earlier row: refused before anything is written.
+  output::RunFile run(dir / "other.h5", kScene);
+  run.writeFrame(frames[0].snapshot(), grown);
+  CHECK_THROWS_WITH(run.writeFrame(frames[1].snapshot(), scene), Catch::Contains("rows are only ever added"));
+  auto looped = grown;
+  looped.push_back(fragments);
+  looped.back().made_from = 3;
+  CHECK_THROWS_WITH(run.writeFrame(frames[1].snapshot(), looped),
+                    Catch::Contains("materials row 3") && Catch::Contains("made_from 3"));
+  CHECK(run.frameCount() == 1);
+  run.close(false);
+
+  // A damaged table is refused naming the file and the row.
+  const fs::path damaged = dir / "damaged.h5";
+  fs::copy_file(partialOf(path), damaged);
+  auto error = [&] {
+    try {
+      output::RunFileReader bad(damaged);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  {
+    H5::H5File file(damaged.string(), H5F_ACC_RDWR);
+    const H5::Group row = file.openGroup("materials/000002");
+    row.unlink("made_from");
+    const std::int32_t bad = 2;
+    const hsize_t n = 1;
+    row.createDataSet("made_from", H5::PredType::NATIVE_INT32, H5::DataSpace(1, &n))
+        .write(&bad, H5::PredType::NATIVE_INT32);
+  }
+  CHECK_THAT(error(), Catch::Contains(damaged.string()) && Catch::Contains("/materials/000002: made_from: 2") &&
+                          Catch::Contains("an earlier row"));
+  H5::H5File(damaged.string(), H5F_ACC_RDWR).openGroup("materials").unlink("000001");
+  CHECK_THAT(error(), Catch::Contains("/materials/000001: missing"));
+}
+
 TEST_CASE("output: vtk series frames and collection", "[output]") {
   TempDir dir;
   const fs::path directory = dir / "paraview/drop";  // created by VtkSeries

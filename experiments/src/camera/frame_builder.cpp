@@ -1,5 +1,7 @@
 #include "camera/frame_builder.h"
 
+#include <algorithm>
+
 #include "camera/fragment_colours.h"
 #include "camera/plane_look.h"
 #include "rocklab/sim/wall_motion.h"
@@ -38,11 +40,21 @@ render::FrameDescription FrameBuilder::describe(const sim::Snapshot& s, const si
   render::FrameDescription f;
   f.time = s.time;
   f.index = index;
+  // A material made during the run (a breakage's fragment class) in the colour
+  // of the one it was made from (Material::made_from, an earlier row).
+  std::vector<render::Rgb> by_material(std::max(model.materials.size(), material_colours_.size()),
+                                       render::kGreyPebble);
+  for (std::size_t m = 0; m < by_material.size(); ++m) {
+    const int from = m < model.materials.size() ? model.materials[m].made_from : -1;
+    by_material[m] = m < material_colours_.size()                      ? material_colours_[m]
+                     : from >= 0 && static_cast<std::size_t>(from) < m ? by_material[static_cast<std::size_t>(from)]
+                                                                       : render::kGreyPebble;
+  }
   const std::size_t n = s.position.size();
   std::vector<render::Rgb> colour(n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto m = static_cast<std::size_t>(s.material[i]);
-    colour[i] = m < material_colours_.size() ? material_colours_[m] : render::kGreyPebble;
+    colour[i] = m < by_material.size() ? by_material[m] : render::kGreyPebble;
   }
   if (colour_by_ == ColourBy::Fragment) colour = fragmentColours(s, colour);
   f.spheres.reserve(n);

@@ -1,7 +1,8 @@
 #pragma once
 // A simulation snapshot as the renderer's frame description: every ball a
-// sphere (marker bodies red, the others in their material's colour, or by
-// fragment: camera/fragment_colours.h), every active wall a polygon, a mesh,
+// sphere (marker bodies red, the others in their material's colour, a material
+// made during the run in that of the one it was made from (Material::made_from),
+// or by fragment: camera/fragment_colours.h), every active wall a polygon, a mesh,
 // or for an infinite plane its look (camera/plane_look.h: square or disc, flat
 // or a slab), in its pose at the snapshot's time. The renderer never sees sim types.
 #include <cstdint>
@@ -25,7 +26,8 @@ std::string sceneIndexProblem(const sim::Snapshot& s, const sim::Model& model);
 class FrameBuilder {
  public:
   explicit FrameBuilder(const Scene& scene, ColourBy colour_by = ColourBy::Material);
-  /// `model` is the world's current model (walls may have been switched on or off).
+  /// `model` is the world's current model (walls may have been switched on or off,
+  /// materials added: a breakage's fragment classes).
   render::FrameDescription describe(const sim::Snapshot& s, const sim::Model& model,
                                     const std::unordered_set<std::uint64_t>& marker_bodies,
                                     std::uint64_t index) const;

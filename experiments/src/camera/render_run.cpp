@@ -13,10 +13,28 @@
 
 namespace rocklab::experiments {
 
+std::string addRunMaterials(const std::vector<sim::Material>& stored, sim::Model& model) {
+  if (stored.empty()) return {};
+  const std::size_t own = model.materials.size();
+  if (stored.size() < own)
+    return "/materials has " + std::to_string(stored.size()) + " rows, fewer than the stored scene's " +
+           std::to_string(own) + " materials";
+  for (std::size_t k = 0; k < own; ++k)
+    if (stored[k].name != model.materials[k].name)
+      return "/materials row " + std::to_string(k) + " is '" + stored[k].name + "', the stored scene's material " +
+             std::to_string(k) + " is '" + model.materials[k].name + "'";
+  model.materials.insert(model.materials.end(), stored.begin() + static_cast<std::ptrdiff_t>(own), stored.end());
+  return {};
+}
+
 int renderRun(const RenderRunOptions& o, std::ostream& log) {
   try {
     sim::output::RunFileReader run(o.run_file);
     Scene scene = loadSceneText(run.sceneText(), o.run_file.string() + ":/scene", {}, o.run_file.parent_path());
+    if (const std::string bad = addRunMaterials(run.materials(), scene.model); !bad.empty()) {
+      log << "error: run file '" << o.run_file.string() << "': " << bad << "\n";
+      return kExitBadInput;
+    }
     std::vector<CameraSettings> cameras = o.camera_file.empty() ? scene.cameras : loadCameras(o.camera_file);
     if (cameras.empty()) {
       log << "error: " << o.run_file.string() << ": the stored scene has no [[cameras]]; give --camera CAMERA.toml\n";
@@ -30,7 +48,12 @@ int renderRun(const RenderRunOptions& o, std::ostream& log) {
     // frame must not leave some stills replaced and the rest old.
     for (std::size_t k = 0; k < run.frameCount(); ++k)
       if (const std::string bad = sceneIndexProblem(run.frame(k), scene.model); !bad.empty()) {
-        log << "error: run file '" << o.run_file.string() << "' frame " << k << ": " << bad << "\n";
+        log << "error: run file '" << o.run_file.string() << "' frame " << k << ": " << bad;
+        if (run.materials().empty() && bad.starts_with("material"))
+          log << "; the file has no /materials, the table of the materials made during the run (a breakage's "
+                 "fragment classes): it was written before rocklab stored them (2026-12-05). Run the scene "
+                 "again to re-render it";
+        log << "\n";
         return kExitBadInput;
       }
     // From results.json beside the run: the markers the chute chose, and where

@@ -3,6 +3,10 @@
 // scene's cameras or those of a camera file, without running the simulation.
 #include <filesystem>
 #include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "rocklab/sim/model.h"
 
 namespace rocklab::experiments {
 
@@ -11,6 +15,11 @@ struct RenderRunOptions {
   std::filesystem::path camera_file;  // "" = the cameras of the stored scene
   std::filesystem::path out_dir;      // "" = the run file's folder
 };
+
+/// Adds to `model` (the stored scene's) the materials the run made, from the
+/// file's /materials (sim::output::RunFileReader::materials): the rows past the
+/// scene's. "" or why the table does not fit the scene (nothing added then).
+std::string addRunMaterials(const std::vector<sim::Material>& stored, sim::Model& model);
 
 /// Renders every stored frame with every camera (movie, stills). Markers are
 /// read from results.json beside the run file when it exists. Returns an ExitCode.

@@ -105,6 +105,7 @@ int CrusherBreakage::fragmentMaterial(sim::Model& model, int material, double di
   m.name = feed.name + " fragments " + mm(lo) + "-" + mm(hi) + " mm";
   m.kn = 2.0 * lo * std::sqrt(s_.class_ratio) * s_.youngs_modulus;
   m.ks = m.kn * (feed.kn > 0 ? feed.ks / feed.kn : 1.0);
+  m.made_from = base;  // drawn in the feed's colour (run.h5 /materials)
   model.materials.push_back(m);
   base_of_[it->second] = base;
   return it->second;

@@ -195,7 +195,9 @@ class RunLoop {
     last.wall_contacts = s.wall_contacts;
     if (setup_.run_file) {
       setup_.run_file->appendEnergy(s);
-      if (frame_due_) setup_.run_file->writeFrame(s);
+      // With the materials the experiment made (a breakage's fragment classes):
+      // `rocklab render` needs them to draw the frame.
+      if (frame_due_) setup_.run_file->writeFrame(s, world_->model().materials);
     }
     if (setup_.vtk && frame_due_) setup_.vtk->writeFrame(s);
     if (setup_.vtk_walls && frame_due_) setup_.vtk_walls->writeWalls(world_->model(), s.time);

@@ -99,6 +99,104 @@ void writeOncePerFile(const H5::Group& file, const H5::Group& frame, const char*
   }
 }
 
+// /materials: one group per row of the run's materials table (run_file.h).
+constexpr const char* kMaterialsGroup = "materials";
+constexpr std::size_t kMaterialProperties = 6;
+constexpr const char* kMaterialColumnNames =
+    "density [kg/m^3], kn [N/m], ks [N/m], friction [-], shear_modulus [Pa], poisson [-]";
+constexpr const char* kMaterialUnits = "kg/m^3, N/m, N/m, -, Pa, -";
+
+std::string materialGroupName(std::size_t row) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06zu", row);
+  return name;
+}
+
+/// "" or why the rows of `materials` past the `written` ones cannot be added.
+std::string materialsProblem(std::span<const Material> materials, std::size_t written) {
+  if (materials.empty()) return {};  // no table with this frame: nothing to add
+  if (materials.size() < written)
+    return "materials: the table has " + std::to_string(materials.size()) + " rows, /materials already holds " +
+           std::to_string(written) + " (rows are only ever added)";
+  for (std::size_t k = written; k < materials.size(); ++k)
+    if (const int from = materials[k].made_from; from < -1 || from >= static_cast<int>(k))
+      return "materials row " + std::to_string(k) + " ('" + materials[k].name + "'): made_from " +
+             std::to_string(from) + " (allowed: -1 or an earlier row, 0 to " + std::to_string(k) + " - 1)";
+  return {};
+}
+
+void writeMaterial(const H5::Group& file, std::size_t row, const Material& m) {
+  const H5::Group table =
+      file.nameExists(kMaterialsGroup) ? file.openGroup(kMaterialsGroup) : file.createGroup(kMaterialsGroup);
+  const H5::Group group = table.createGroup(materialGroupName(row));
+  writeText(group, "name", m.name);
+  const std::array<double, kMaterialProperties> values{m.density, m.kn, m.ks, m.friction, m.shear_modulus, m.poisson};
+  writeArray(group, "properties", std::span<const double>(values), kMaterialUnits);
+  writeTextAttribute(group.openDataSet("properties"), "columns", kMaterialColumnNames);
+  const std::array<std::int32_t, 1> from{m.made_from};
+  writeArray(group, "made_from", std::span<const std::int32_t>(from), "-");
+}
+
+/// A scalar string dataset written by writeText, its checksum verified.
+std::string readText(const H5::Group& group, const char* name) {
+  if (!group.nameExists(name)) throw std::runtime_error(std::string("no dataset ") + name);
+  const H5::DataSet dataset = group.openDataSet(name);
+  if (dataset.getTypeClass() != H5T_STRING || dataset.getSpace().getSimpleExtentNpoints() != 1)
+    throw std::runtime_error(std::string("dataset ") + name + " is not a single string");
+  std::string text;
+  dataset.read(text, dataset.getStrType());
+  if (const auto c = detail::verifyChecksum(dataset, text.data(), text.size()); !c.matches)
+    throw std::runtime_error(std::string("dataset ") + name + ": " + c.mismatch());
+  return text;
+}
+
+/// /materials as stored; empty without it. Throws std::runtime_error naming the
+/// row's group and what is wrong (a missing row, a bad shape, a made_from that is
+/// not an earlier row, a value that is not a finite number).
+std::vector<Material> readMaterials(const H5::H5File& file) {
+  if (!file.nameExists(kMaterialsGroup)) return {};
+  const H5::Group table = file.openGroup(kMaterialsGroup);
+  std::vector<std::string> rows;
+  for (hsize_t k = 0; k < table.getNumObjs(); ++k) rows.push_back(table.getObjnameByIdx(k));
+  std::sort(rows.begin(), rows.end());
+  std::vector<Material> materials;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const std::string where = "/" + std::string(kMaterialsGroup) + "/" + materialGroupName(k);
+    if (rows[k] != materialGroupName(k))
+      throw std::runtime_error(where + ": missing (the table has '" + rows[k] + "' in its place)");
+    try {
+      const H5::Group group = table.openGroup(rows[k]);
+      Material m;
+      m.name = readText(group, "name");
+      const std::vector<double> values = detail::readArray<double>(group, "properties");
+      if (values.size() != kMaterialProperties)
+        throw std::runtime_error("dataset properties has " + std::to_string(values.size()) + " values (allowed: " +
+                                 std::to_string(kMaterialProperties) + ")");
+      for (const double v : values)
+        if (!std::isfinite(v)) throw std::runtime_error("dataset properties: " + std::to_string(v) + " is not finite");
+      m.density = values[0];
+      m.kn = values[1];
+      m.ks = values[2];
+      m.friction = values[3];
+      m.shear_modulus = values[4];
+      m.poisson = values[5];
+      const std::vector<std::int32_t> from = detail::readArray<std::int32_t>(group, "made_from");
+      if (from.size() != 1)
+        throw std::runtime_error("dataset made_from has " + std::to_string(from.size()) + " values (allowed: 1)");
+      if (from[0] < -1 || from[0] >= static_cast<std::int32_t>(k))
+        throw std::runtime_error("made_from: " + std::to_string(from[0]) + " (allowed: -1 or an earlier row, 0 to " +
+                                 std::to_string(k) + " - 1)");
+      m.made_from = from[0];
+      materials.push_back(std::move(m));
+    } catch (const H5::Exception& e) {
+      throw std::runtime_error(where + ": " + e.getDetailMsg());
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
+  }
+  return materials;
+}
+
 std::string bondProblemText(const detail::ArrayProblem& p) {
   return std::string(p.array) + " row " + std::to_string(p.row) + ": " + p.what;
 }
@@ -162,6 +260,7 @@ struct RunFile::Impl {
   detail::FileHandle handle;  // closed once (a full disk must not crash a second close)
   H5::DataSet energy;
   SnapshotArrays per_file;  // what /bonds holds (PerFile arrays), empty until written
+  std::size_t materials = 0;  // rows in /materials
   hsize_t energy_rows = 0;
   std::size_t frames = 0;
   bool open = true;
@@ -207,12 +306,17 @@ void RunFile::discard() noexcept {
   std::filesystem::remove(impl_->partial, ignored);
 }
 
-void RunFile::writeFrame(const Snapshot& snapshot) {
+void RunFile::writeFrame(const Snapshot& snapshot, std::span<const Material> materials) {
   impl_->requireOpen("writeFrame");
   // The arrays are checked before anything is written.
   if (const auto bad = detail::bondProblem(snapshot, particleCount(snapshot)))
     throw std::invalid_argument("snapshot: " + bondProblemText(*bad));
+  if (const std::string bad = materialsProblem(materials, impl_->materials); !bad.empty())
+    throw std::invalid_argument(bad);
   guardedWrite(*impl_, "write a frame", [&] {
+    // The new materials first: a frame is never on disk without the rows it uses.
+    for (; impl_->materials < materials.size(); ++impl_->materials)
+      writeMaterial(impl_->file(), impl_->materials, materials[impl_->materials]);
     const H5::Group frame = impl_->file().createGroup(frameGroupName(impl_->frames));
     writeScalarAttribute(frame, "time", H5::PredType::NATIVE_DOUBLE, snapshot.time);
     writeScalarAttribute(frame, "step", H5::PredType::NATIVE_UINT64, snapshot.step);
@@ -294,6 +398,7 @@ struct RunFileReader::Impl {
   std::filesystem::path path;
   H5::H5File file;
   std::string scene;
+  std::vector<Material> materials;  // /materials, empty without it
   std::vector<std::string> frame_names;
   SnapshotArrays current;   // the current frame's arrays
   SnapshotArrays per_file;  // /bonds: the PerFile arrays of the frames that do not carry their own
@@ -317,6 +422,7 @@ RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::mak
     scene.read(impl_->scene, scene.getStrType());
     if (const auto c = detail::verifyChecksum(scene, impl_->scene.data(), impl_->scene.size()); !c.matches)
       throw std::runtime_error(where + "dataset /scene: " + c.mismatch());
+    impl_->materials = readMaterials(impl_->file);
     const H5::Group frames = impl_->file.openGroup("frames");
     for (hsize_t k = 0; k < frames.getNumObjs(); ++k) impl_->frame_names.push_back(frames.getObjnameByIdx(k));
     std::sort(impl_->frame_names.begin(), impl_->frame_names.end());  // 000000, 000001, ...
@@ -338,6 +444,7 @@ RunFileReader::RunFileReader(const std::filesystem::path& path) : impl_(std::mak
 RunFileReader::~RunFileReader() = default;
 
 const std::string& RunFileReader::sceneText() const { return impl_->scene; }
+const std::vector<Material>& RunFileReader::materials() const { return impl_->materials; }
 std::size_t RunFileReader::frameCount() const { return impl_->frame_names.size(); }
 
 const Snapshot& RunFileReader::frame(std::size_t k) {

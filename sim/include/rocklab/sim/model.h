@@ -22,6 +22,10 @@ struct Material {
   double friction = 0.37;       // -     Coulomb coefficient; a pair uses the smaller (ref §5)
   double shear_modulus = 0.0;   // Pa    G (Hertz–Mindlin, Eq 2-22)
   double poisson = 0.2;         // -     nu (Hertz–Mindlin)
+  // The material this one was made from during a run (a breakage's fragment class
+  // is a copy of its feed's), an earlier row of the same table; -1 for a scene's own.
+  // A renderer draws it in that material's colour; run.h5 stores it (/materials).
+  int made_from = -1;
 };
 
 enum class ContactLaw { Linear, HertzMindlin };

@@ -21,14 +21,26 @@
 //   /energy                [rows, 8] double, extendible and chunked; columns (attr "columns"):
 //                          time s, step, kinetic_translational J, kinetic_rotational J,
 //                          potential_gravity J, elastic J, total J, contacts
+//   /materials/000000, ... the run's materials table (sim::Model::materials), one group per
+//                          row: name (string), properties [6] double (attr "columns": density
+//                          kg/m^3, kn N/m, ks N/m, friction, shear_modulus Pa, poisson),
+//                          made_from [1] int32 (Material::made_from: -1, or the earlier row it
+//                          was copied from). A row is written, with the frame that first can
+//                          use it, when the table grows (a breakage's fragment classes); the
+//                          frames' material indices are rows of it. Files written before
+//                          2026-12-05, and by writers that pass no table, have none (their
+//                          frames use only the scene's materials).
 //
 // Safe writing: the file is written as `<path>.partial` and renamed to `<path>`
 // by close(), so a good run.h5 is never replaced by a half-written one. The file
 // is flushed after every frame, so even the .partial of a killed run is readable.
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
+#include "rocklab/sim/model.h"
 #include "rocklab/sim/snapshot.h"
 
 namespace rocklab::sim::output {
@@ -43,8 +55,12 @@ class RunFile {
   RunFile& operator=(const RunFile&) = delete;
 
   /// A failure (a full disk) throws OutputError (file_write.h) naming the file and
-  /// the system's reason; the file is failed() from then on.
-  void writeFrame(const Snapshot& snapshot);
+  /// the system's reason; the file is failed() from then on. `materials`: the
+  /// run's materials table at this frame (the world's Model::materials); its rows
+  /// not yet in /materials go there first, in the frame's flush, so a frame's
+  /// materials survive a kill with it. Rows are only ever added: a shorter table,
+  /// or a made_from that is not an earlier row, throws std::invalid_argument.
+  void writeFrame(const Snapshot& snapshot, std::span<const Material> materials = {});
   void appendEnergy(const Snapshot& snapshot);
   std::size_t frameCount() const;
   /// Marks the file complete (or interrupted), closes it and renames it into
@@ -71,6 +87,9 @@ class RunFileReader {
   RunFileReader& operator=(const RunFileReader&) = delete;
 
   const std::string& sceneText() const;
+  /// /materials: the run's materials table as of its last stored frame (the
+  /// scene's and those made during the run); empty when the file has none.
+  const std::vector<Material>& materials() const;
   std::size_t frameCount() const;
   /// Frame k as a snapshot (energy not included); valid until the next call.
   /// Throws std::runtime_error naming the file, the frame, and for a bad bond
