@@ -29,24 +29,30 @@ struct Marker {
 // drawn at its projected centre as a disc of kShown of its equivalent sphere's
 // radius (a marker partly hidden among pebbles shows less than its equivalent disc).
 constexpr double kShown = 0.85;
-cv::Mat frameAt(const geometry::Camera& camera, const std::vector<Marker>& markers, double t, int k) {
+cv::Mat frameAt(const geometry::Camera& camera, const std::vector<Marker>& markers, double t, int k,
+               double shown = kShown) {
   cv::Mat frame = greyFrame({camera.width, camera.height}, 15.0, 1000 + static_cast<std::uint64_t>(k));
   for (const Marker& m : markers) {
     const Vec3 c = m.at(t);
     const geometry::Vec2 px = camera.project(c);
-    const double r_px = kShown * camera.fx * kMarkerRadius / camera.toCamera(c).z();
+    const double r_px = shown * camera.fx * kMarkerRadius / camera.toCamera(c).z();
     drawDisc(frame, {px.x(), px.y()}, r_px);
   }
   return frame;
+}
+
+geometry::Camera chuteCamera() {
+  geometry::Camera camera = geometry::Camera::withFieldOfView(640, 480, 60.0);
+  camera.frameRate = kFrameRate;
+  camera.lookAt(Vec3(0.0, -0.35, 0.03), Vec3(0.0, 0.15, 0.03), Vec3::UnitZ());
+  return camera;
 }
 
 }  // namespace
 
 TEST_CASE("two markers merged in the first noisy frame start two tracks with their own velocities",
           "[experiments][tracking]") {
-  geometry::Camera camera = geometry::Camera::withFieldOfView(640, 480, 60.0);
-  camera.frameRate = kFrameRate;
-  camera.lookAt(Vec3(0.0, -0.35, 0.03), Vec3(0.0, 0.15, 0.03), Vec3::UnitZ());
+  const geometry::Camera camera = chuteCamera();
   // One above the other, their shown discs overlapping by 0.3 of their radius: one
   // blob of about 1.5 marker areas (fill ~0.6), more than one marker covers but under
   // the former size rule's 1.8 (issue 25: 1.75, fill 0.40), so it was one detection
@@ -87,5 +93,48 @@ TEST_CASE("two markers merged in the first noisy frame start two tracks with the
     CHECK_FALSE(v.merged);
     REQUIRE(v.complete);
     CHECK(v.velocity == Approx(markers[m].speed).epsilon(0.01));
+  }
+}
+
+TEST_CASE("a red speck for one frame ahead of two touching markers starts no track that cuts them apart",
+          "[experiments][tracking]") {
+  // Two touching markers, one ahead of the other, move together: one blob, cut at
+  // their two tracks' predictions. For one frame a speck of red (6 % of a marker's
+  // disc) shows 4 px ahead of the leading marker. At sensor noise 15 such a speck
+  // where two markers met started a track (issue 25), whose prediction stood still
+  // until the leading marker ran over it and was then a third seed in the pair's
+  // blob: the marker was cut in two and its track lost. A blob under a tenth of a
+  // marker's disc is no marker (MarkerTracking: the detector's min_area_px). Without
+  // that bound the speck's track cut a third piece off the pair five frames later,
+  // and that piece was tracked beside the marker to the end.
+  const geometry::Camera camera = chuteCamera();
+  constexpr double kShownPair = 0.9;  // two shown discs cover 1.6 marker discs: one blob to cut
+  const double z = 0.03, speed = 0.3;
+  const std::vector<Marker> markers{{Vec3(0.04, kPlaneY, z), speed},
+                                    {Vec3(0.04 + 2 * kShownPair * kMarkerRadius, kPlaneY, z), speed}};
+  experiments::MarkerTracking tracking(camera, 0.002, kMeasure);
+  tracking.setMarkers(kPlaneY, kMarkerRadius);
+  tracking.setReferenceTime(0.0);
+  const double r_px = tracking.markerRadiusPx();
+  const int speck_frame = 10;  // moving since frame 5
+  const int frames = static_cast<int>(std::ceil((kStill + kMeasure / speed + 0.02) * kFrameRate));
+  for (int k = 0; k < frames; ++k) {
+    const double t = k / kFrameRate;
+    cv::Mat frame = frameAt(camera, markers, t, k, kShownPair);
+    if (k == speck_frame) {
+      const geometry::Vec2 lead = camera.project(markers[0].at(t));
+      const double shown_px = kShownPair * r_px, speck_px = 0.25 * r_px;
+      drawDisc(frame, {lead.x() - shown_px - 4.0 - speck_px, lead.y()}, speck_px);  // image u grows with x
+    }
+    tracking.addFrame(static_cast<std::uint64_t>(k), t, frame);
+  }
+  const experiments::MarkerTracking::Result result = tracking.finish();
+  CHECK(result.tracks.size() == 2);
+  CHECK(result.unresolved.empty());
+  REQUIRE(result.velocities.size() == result.tracks.size());
+  for (const track::MarkerVelocity& v : result.velocities) {
+    INFO("track " << v.track_id);
+    REQUIRE(v.complete);
+    CHECK(v.velocity == Approx(speed).epsilon(0.01));
   }
 }
