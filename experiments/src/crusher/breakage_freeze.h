@@ -153,6 +153,9 @@ struct FreezeResult {
   std::size_t balls = 0;           // balls in the freeze World (the last run of it)
   int reach_widenings = 0;         // "local": runs repeated with the reach doubled
   std::size_t moved_neighbours = 0;  // "local": neighbours that moved with the fragments (not loaded)
+  // Rows of `state` whose positions the freeze moved: the fragments and the moved
+  // neighbours ("local"), every ball ("all"); empty when nothing came back.
+  std::vector<std::uint32_t> movers;
 };
 
 /// Relaxes the balls `fragments` (rows of state.particles) of `state` at time
