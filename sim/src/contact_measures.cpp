@@ -53,9 +53,12 @@ inline Mat3 stressMoment(const Vec3& x, const Vec3& f) {
 /// shear spring of the last step; no dashpots) of the state at the current time:
 /// the balls where the last step moved them, the walls where their motion puts
 /// them now (the stage-1 poses are a step old: a moving platen would read the
-/// overlap of a step ago).
+/// overlap of a step ago). The visitors also get the shear spring (force, N).
+/// `by_geometry`: every listed pair and wall contact that overlaps counts, not
+/// only those the last force pass flagged (a World from a saved state before its
+/// first step has no flags yet).
 template <class Law, class PairVisit, class WallVisit>
-void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const {
+void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall, bool by_geometry) const {
   // A World built from spheres has no contact lists before its first step (it
   // builds them there): no contacts yet.
   if (nb.pairs.row_offset.size() != p.size() + 1) return;
@@ -63,7 +66,7 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
   for (std::size_t k = 0; k < walls_now.size(); ++k) walls_now[k].update(model.walls[k], time);
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
-      if (!history.pair_touch[k]) continue;
+      if (!by_geometry && !history.pair_touch[k]) continue;
       const std::uint32_t j = nb.pairs.partner[k];
       ContactPoint touch;
       if (!ballBallTouch(p.position[i], p.position[j], p.radius[i], p.radius[j], touch)) continue;
@@ -72,10 +75,11 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       double secant, tangent;
       Law::normal(pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), secant,
                   tangent);
-      pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal), overlap);
+      pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal), overlap,
+           history.pair_shear[k]);
     }
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
-      if (!history.wall_touch[c]) continue;
+      if (!by_geometry && !history.wall_touch[c]) continue;
       const std::uint32_t wk = nb.wall_index[c];
       ContactPoint touch;
       if (!ballWallTouch(walls_now[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch)) continue;
@@ -83,7 +87,8 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
       if (overlap <= 0) continue;
       double secant, tangent;
       Law::normal(wallProps(i, wk), overlap, p.radius[i], secant, tangent);
-      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal), overlap);
+      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal), overlap,
+           history.wall_shear[c]);
     }
   }
 }
@@ -91,8 +96,8 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall) cons
 template <class Law>
 std::vector<Vec3> World::Impl::wallLoads() const {
   std::vector<Vec3> load(model.walls.size(), Vec3::Zero());
-  forEachElasticContact<Law>([](std::size_t, std::uint32_t, const Vec3&, const Vec3&, double) {},
-                             [&](std::size_t, std::uint32_t wk, const Vec3&, const Vec3& on_ball, double) {
+  forEachElasticContact<Law>([](std::size_t, std::uint32_t, const Vec3&, const Vec3&, double, const Vec3&) {},
+                             [&](std::size_t, std::uint32_t wk, const Vec3&, const Vec3& on_ball, double, const Vec3&) {
                                load[wk] -= on_ball;  // the wall feels minus the force on the ball
                              });
   return load;
@@ -107,16 +112,21 @@ std::vector<Vec3> World::wallForces() const {
 template <class Law>
 TouchingContacts World::Impl::touching() const {
   TouchingContacts t;
+  // The energies as the energy log has them (stages/energy.cpp): one formula.
   forEachElasticContact<Law>(
-      [&](std::size_t i, std::uint32_t j, const Vec3&, const Vec3&, double overlap) {
+      [&](std::size_t i, std::uint32_t j, const Vec3&, const Vec3&, double overlap, const Vec3& shear) {
         t.pairs.emplace_back(static_cast<std::uint32_t>(std::min<std::size_t>(i, j)),
                              static_cast<std::uint32_t>(std::max<std::size_t>(i, j)));
         t.pair_overlap.push_back(overlap);
+        t.pair_energy.push_back(
+            detail::elasticEnergy<Law>(pairProps(i, j), overlap, effectiveRadius(p.radius[i], p.radius[j]), shear));
       },
-      [&](std::size_t i, std::uint32_t wk, const Vec3&, const Vec3&, double overlap) {
+      [&](std::size_t i, std::uint32_t wk, const Vec3&, const Vec3&, double overlap, const Vec3& shear) {
         t.walls.emplace_back(static_cast<std::uint32_t>(i), wk);
         t.wall_overlap.push_back(overlap);
-      });
+        t.wall_energy.push_back(detail::elasticEnergy<Law>(wallProps(i, wk), overlap, p.radius[i], shear));
+      },
+      !forces_evaluated);
   return t;
 }
 
@@ -128,11 +138,11 @@ TouchingContacts World::touchingContacts() const {
 template <class Law>
 void World::Impl::contactStress(std::vector<Mat3>& sum) const {
   forEachElasticContact<Law>(
-      [&](std::size_t i, std::uint32_t j, const Vec3& point, const Vec3& on_i, double) {
+      [&](std::size_t i, std::uint32_t j, const Vec3& point, const Vec3& on_i, double, const Vec3&) {
         sum[i] += stressMoment(point - p.position[i], on_i);
         sum[j] += stressMoment(point - p.position[j], -on_i);
       },
-      [&](std::size_t i, std::uint32_t, const Vec3& point, const Vec3& on_i, double) {
+      [&](std::size_t i, std::uint32_t, const Vec3& point, const Vec3& on_i, double, const Vec3&) {
         sum[i] += stressMoment(point - p.position[i], on_i);
       });
 }

@@ -62,6 +62,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   {
     StageTimer timer(stageSeconds(Stage::Forces));
     forceStage(plan, checks);  // 3
+    forces_evaluated = true;
   }
   if (plan.bonds) {
     StageTimer timer(stageSeconds(Stage::Bonds));

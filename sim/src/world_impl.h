@@ -134,6 +134,9 @@ struct World::Impl {
   std::uint64_t step = 0;
   double dt = 0.0;
   bool half_kick_pending = true;
+  // Whether a force pass has run in this World (the touch flags are its): before
+  // it, World::touchingContacts goes by the positions.
+  bool forces_evaluated = false;
   Vec3 gravity = Vec3::Zero();
   TimestepAudit audit;
   WorldStats stats;
@@ -349,7 +352,7 @@ struct World::Impl {
   std::string stepAdvice() const;
   // On demand (contact_measures.cpp): World::particleStress, World::wallForces.
   template <class Law, class PairVisit, class WallVisit>
-  void forEachElasticContact(PairVisit&& pair, WallVisit&& wall) const;
+  void forEachElasticContact(PairVisit&& pair, WallVisit&& wall, bool by_geometry = false) const;
   template <class Law> void contactStress(std::vector<geometry::Mat3>& sum) const;
   template <class Law> std::vector<Vec3> wallLoads() const;
   template <class Law> TouchingContacts touching() const;

@@ -211,6 +211,7 @@ TEST_CASE("a freeze that does not end within its cap keeps the breakage (break),
     settings.freeze.max_cycles = 5;  // the fragments need ~40
     settings.freeze.check_cycles = 1;
     settings.freeze.crowded = outcome;
+    settings.crowded_bound = BreakageSettings::CrowdedBound::Overlap;
     settings.crowded_max_overlap = std::numeric_limits<double>::infinity();  // "break" keeps what 5 cycles leave
     settings.defer_time = 1e-4;  // s: the platens close 20 um in it
     CrusherBreakage breakage(settings, 3);
@@ -296,6 +297,7 @@ TEST_CASE("a crowded freeze under break whose overlap is above freeze_crowded_ma
   BreakageSettings settings = pinchSettings();
   settings.freeze.max_cycles = 5;  // cut before the fragments part: crowded at a large overlap
   settings.freeze.check_cycles = 1;
+  settings.crowded_bound = BreakageSettings::CrowdedBound::Overlap;
   settings.crowded_max_overlap = 1e-3;
   settings.defer_time = 0;
   CrusherBreakage breakage(settings, 3);
@@ -318,6 +320,126 @@ TEST_CASE("a crowded freeze under break whose overlap is above freeze_crowded_ma
   const nlohmann::json r = breakage.report({8, 16}, out);
   REQUIRE(r["deferred"].size() == 2);
   CHECK(r["deferred"][0]["overlap_fraction"].get<double>() > settings.crowded_max_overlap);
+  fs::remove_all(out);
+}
+
+namespace {
+
+/// One 20 mm ball at rest squeezed by `squeeze` (m) between two static planes
+/// (no gravity, friction or damping: the run's mechanical energy is conserved
+/// but for what a breakage changes).
+std::unique_ptr<sim::World> squeezedBall(double squeeze) {
+  std::unique_ptr<sim::World> pinched = pinchedBall(0.0);
+  sim::Model m = pinched->model();
+  m.walls[0].point.z() += squeeze;
+  m.walls[1].point.z() -= squeeze;
+  m.watchdog.max_overlap_fraction = std::numeric_limits<double>::infinity();  // crowded fragments overlap
+  return std::make_unique<sim::World>(m, sim::WorldState(pinched->exportState()), 1);
+}
+
+/// Checks and steps `world` until a check breaks a ball or defers one; returns
+/// whether it broke, with the run's energy after the step before that check.
+bool untilBrokenOrDeferred(std::unique_ptr<sim::World>& world, CrusherBreakage& breakage, sim::Energy& before) {
+  const ExperimentContext ctx{1, nullptr};
+  for (int steps = 0; steps < 100; ++steps) {
+    before = energyAfterStep(world);
+    if (breakage.check(world, ctx)) return true;
+    if (breakage.progress().find("deferred") != std::string::npos) return false;
+  }
+  FAIL("neither broken nor deferred in 100 steps");
+  return false;
+}
+
+double mechanical(const sim::Energy& e) { return e.kinetic_translational + e.kinetic_rotational + e.elastic; }
+
+}  // namespace
+
+TEST_CASE("under freeze_crowded_bound = energy a crowded breakage is kept only when its fragments' overlaps hold no "
+          "more elastic energy than the parent's contacts stored, and then the run's energy does not rise",
+          "[crusher]") {
+  BreakageSettings settings = pinchSettings();
+  settings.strength.q_ref = 1e5;  // Pa: the lightest squeeze below breaks the ball at the first check
+  // The fragments part after 40 cycles: cut at 39 the freeze is crowded with an
+  // overlap of 0.0045 of the radius left (0.17 J at rock stiffness), 15 times the
+  // old bound (freeze_crowded_max_overlap 3e-4).
+  settings.freeze.max_cycles = 39;
+  settings.freeze.check_cycles = 1;
+  REQUIRE(settings.crowded_bound == BreakageSettings::CrowdedBound::Energy);  // the default
+  const fs::path out = test::scratchDir("crusher-breakage-energy-bound");
+  fs::create_directories(out);
+
+  // A parent squeezed by 1 um stores ~1 mJ (two wall contacts at ~1e9 N/m): less
+  // than what the fragments' overlaps after 39 cycles hold at rock stiffness.
+  std::unique_ptr<sim::World> world = squeezedBall(1e-6);
+  CrusherBreakage light(settings, 3);
+  light.start(*world);
+  const sim::World* light_world = nullptr;
+  sim::Energy before;
+  {
+    const ExperimentContext ctx{1, nullptr};
+    before = energyAfterStep(world);
+    light_world = world.get();
+    CHECK_FALSE(light.check(world, ctx));
+  }
+  REQUIRE_THAT(light.progress(), Contains("(1 deferred)"));
+  CHECK(light.events().empty());
+  CHECK(world.get() == light_world);  // the run's World as it was, the ball whole
+  CHECK(world->particles().size() == 1);
+  const nlohmann::json deferred = light.report({8, 16}, out)["deferred"];
+  REQUIRE(deferred.size() == 1);
+  const double parent_light = deferred[0]["parent_energy_J"].get<double>();
+  const double handed_back = deferred[0]["handed_back_energy_J"].get<double>();
+  INFO("parent " << parent_light << " J, fragments' overlaps " << handed_back << " J, overlap "
+                 << deferred[0]["overlap_fraction"].get<double>());
+  // The parent's energy is its two wall springs', as the run's energy log has them.
+  CHECK(parent_light == Approx(before.elastic).epsilon(1e-6));
+  CHECK(handed_back > parent_light);
+
+  // The same freeze (the fragments do not reach the planes) after a squeeze that
+  // stores 4 times what the fragments will hold (elastic energy ~ squeeze^2): kept.
+  const double squeeze = 1e-6 * std::sqrt(4 * handed_back / parent_light);
+  INFO("squeeze " << squeeze << " m");
+  REQUIRE(squeeze < 0.1 * 0.01);  // the 60 % fragment (0.843 R) stays clear of the planes
+  world = squeezedBall(squeeze);
+  CrusherBreakage heavy(settings, 3);
+  heavy.start(*world);
+  REQUIRE(untilBrokenOrDeferred(world, heavy, before));
+  REQUIRE(heavy.events().size() == 1);
+  const BreakageEvent& e = heavy.events().front();
+  CHECK(e.freeze_end == crusher::FreezeEnd::Crowded);
+  CHECK(e.freeze_cycles == 39);
+  CHECK(e.parent_energy == Approx(before.elastic).epsilon(1e-6));
+  CHECK(e.handed_back_energy == Approx(handed_back).epsilon(1e-6));
+  CHECK(e.handed_back_energy <= e.parent_energy);
+  // The old rule would have deferred it: the overlap is far above 3e-4 of the radius.
+  CHECK(e.freeze_overlap > 10 * BreakageSettings{}.crowded_max_overlap);
+  // The run's mechanical energy (kinetic + elastic) does not rise: right after the
+  // breakage it is what the fragments' overlaps hold (the handed-back energy) and
+  // below what the parent had; no damping, so it stays there to the integrator's
+  // error (1 %) while the fragments fly apart.
+  sim::Energy after = energyAfterStep(world);
+  INFO("before " << mechanical(before) << " J, after " << mechanical(after) << " J");
+  CHECK(after.elastic + after.kinetic_translational + after.kinetic_rotational ==
+        Approx(e.handed_back_energy).epsilon(1e-2));
+  CHECK(mechanical(after) <= mechanical(before));
+  double highest = mechanical(after);
+  for (int steps = 0; steps < 2000; ++steps) highest = std::max(highest, mechanical(energyAfterStep(world)));
+  CHECK(highest <= e.handed_back_energy * 1.01);
+  CHECK(highest < mechanical(before));
+  const nlohmann::json r = heavy.report({8, 16}, out);
+  CHECK(r["freeze_crowded_bound"] == "energy");
+  CHECK(r["freeze_crowded_energy_factor"] == 1.0);
+  CHECK(r["max_crowded_handed_back_energy_J"].get<double>() == e.handed_back_energy);
+  CHECK(r["max_handed_back_excess_J"].get<double>() <= 0);
+  CHECK_THAT(test::slurp(out / "breakage.csv"), Contains("parent_energy_J,handed_back_energy_J"));
+
+  // With the factor below the ratio the same breakage waits.
+  settings.crowded_energy_factor = 0.5 * e.handed_back_energy / e.parent_energy;
+  world = squeezedBall(squeeze);
+  CrusherBreakage strict(settings, 3);
+  strict.start(*world);
+  CHECK_FALSE(untilBrokenOrDeferred(world, strict, before));
+  CHECK(strict.events().empty());
   fs::remove_all(out);
 }
 
@@ -585,14 +707,18 @@ TEST_CASE("a local freeze moves the neighbours that bore no load like fragments 
   const crusher::FreezeSettings local;
   // The tight row: the fragments overlap each other and fragment 0 the left wall
   // (by 0.5 mm); the rock ball only just meets fragment 1 (no overlap: not
-  // touching). None before the first step.
+  // touching). Before the first step of a World from a saved state, those its
+  // positions overlap: the same.
   FreezeCase tight = fragmentRow(2e-3, 1.25e-3);
   sim::World world(tight.model, tight.state, 1);
   using Pair = std::pair<std::uint32_t, std::uint32_t>;
-  CHECK(world.touchingContacts().pairs.empty());
+  const sim::TouchingContacts unstepped = world.touchingContacts();
   world.step();
   const sim::TouchingContacts t = world.touchingContacts();
   CHECK(t.pairs == std::vector<Pair>{{0, 1}});
+  CHECK(unstepped.pairs == t.pairs);
+  CHECK(unstepped.walls == t.walls);
+  CHECK(unstepped.pair_energy[0] == Approx(0.5 * 5e8 * 2e-3 * 2e-3));  // 1e9 N/m twice in series, 2 mm
   CHECK(std::count(t.walls.begin(), t.walls.end(), Pair{0, 0}) == 1);
   CHECK(std::none_of(t.walls.begin(), t.walls.end(), [](const Pair& c) { return c.first == 1; }));
 
@@ -680,6 +806,15 @@ TEST_CASE("breakage settings: off by default, keys checked by name, and a step t
   CHECK_THAT(error("experiment.breakage.freeze_max_contact_times=-1"),
              Contains("experiment.breakage.freeze_max_contact_times"));
   CHECK(b.freeze.crowded == crusher::CrowdedOutcome::Break);
+  CHECK(b.crowded_bound == BreakageSettings::CrowdedBound::Energy);
+  CHECK(b.crowded_energy_factor == 1.0);
+  CHECK(settingsOf<CrusherRunSettings>(loadScene(scene, {"experiment.breakage.freeze_crowded_bound=\"overlap\""}))
+            .breakage.crowded_bound == BreakageSettings::CrowdedBound::Overlap);
+  CHECK_THAT(error("experiment.breakage.freeze_crowded_bound=\"joules\""),
+             Contains("experiment.breakage.freeze_crowded_bound") && Contains("\"energy\"") &&
+                 Contains("\"overlap\""));
+  CHECK_THAT(error("experiment.breakage.freeze_crowded_energy_factor=-1"),
+             Contains("experiment.breakage.freeze_crowded_energy_factor"));
   CHECK(settingsOf<CrusherRunSettings>(loadScene(scene, {"experiment.breakage.freeze_crowded=\"defer\""}))
             .breakage.freeze.crowded == crusher::CrowdedOutcome::Defer);
   CHECK(
@@ -756,7 +891,8 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
     CHECK(b["max_freeze_balls"].get<int>() >= 3);  // at least the three fragments
     const std::string events = test::slurp(out / "breakage.csv");
     CHECK(std::count(events.begin(), events.end(), '\n') == 1 + b["events"].get<int>());
-    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J\n"));
+    CHECK_THAT(events, Contains("freeze_cycles,freeze_end,freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J,"
+                                "parent_energy_J,handed_back_energy_J\n"));
     if (threads == 1)
       first_events = events;
     else

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 
@@ -298,12 +299,15 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     sim::WorldState after;
     const FreezeResult result =
         runFreeze(model, state, fragments, {}, s, threads, state.time, after);
+    FreezeResult all = result;
     if (handsBack(result.end, s.crowded)) {
       state.particles.position = after.particles.position;
       state.pair_history = after.pair_history;
       state.wall_history = after.wall_history;
+      all.movers.resize(state.particles.size());
+      std::iota(all.movers.begin(), all.movers.end(), 0u);
     }
-    return result;
+    return all;
   }
   if (!loaded.empty() && loaded.size() != p.size())
     throw std::invalid_argument("freezeFragments: one `loaded` flag per ball is needed");
@@ -374,6 +378,7 @@ FreezeResult freezeFragments(const sim::Model& model, sim::WorldState& state,
     }
     state.pair_history = std::move(pairs);
     state.wall_history = std::move(walls);
+    total.movers = movers;
     return total;
   }
 }

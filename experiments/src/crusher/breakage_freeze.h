@@ -66,8 +66,8 @@
 //     median was 7.4, 99 % within 86, 10 of 803 above 80: the slowest that part
 //     in the full chamber reach the cap, docs/crusher.md, seventh attempt.)
 //     What follows is `crowded` (CrowdedOutcome): "break" hands the fragments
-//     back where the freeze left them (the caller bounds the overlap it takes:
-//     crusher_breakage.h); "defer" leaves `state` as it was, and the caller keeps
+//     back where the freeze left them (the caller bounds what it takes, by energy
+//     or overlap: crusher_breakage.h); "defer" leaves `state` as it was, and the caller keeps
 //     the parents whole for a while; "stop" stops the run with a message naming
 //     the settings. (In the 200-ball run two freezes after 1 s were still at
 //     overlaps of 0.12-0.15 of the radius after 1e6 and 4e6 cycles, creeping down
@@ -153,6 +153,9 @@ struct FreezeResult {
   std::size_t balls = 0;           // balls in the freeze World (the last run of it)
   int reach_widenings = 0;         // "local": runs repeated with the reach doubled
   std::size_t moved_neighbours = 0;  // "local": neighbours that moved with the fragments (not loaded)
+  // Rows of `state` whose positions the freeze moved: the fragments and the moved
+  // neighbours ("local"), every ball ("all"); empty when nothing came back.
+  std::vector<std::uint32_t> movers;
 };
 
 /// Relaxes the balls `fragments` (rows of state.particles) of `state` at time

@@ -66,8 +66,20 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   for (const CrowdedOutcome o : outcomes)
     if (crowded == crusher::crowdedOutcomeName(o)) f.crowded = o;
   s.crowded_max_overlap = b->number("freeze_crowded_max_overlap", s.crowded_max_overlap, Range::nonNegative());
+  using Bound = BreakageSettings::CrowdedBound;
+  s.crowded_bound = b->string("freeze_crowded_bound", crowdedBoundName(s.crowded_bound),
+                              {crowdedBoundName(Bound::Energy), crowdedBoundName(Bound::Overlap)}) ==
+                            crowdedBoundName(Bound::Overlap)
+                        ? Bound::Overlap
+                        : Bound::Energy;
+  s.crowded_energy_factor =
+      b->number("freeze_crowded_energy_factor", s.crowded_energy_factor, Range::nonNegative());
   s.defer_time = b->number("defer_time", s.defer_time, Range::nonNegative());
   b->finish();
+}
+
+const char* crowdedBoundName(BreakageSettings::CrowdedBound bound) {
+  return bound == BreakageSettings::CrowdedBound::Overlap ? "overlap" : "energy";
 }
 
 namespace {
@@ -223,6 +235,16 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   std::vector<bool> loaded;  // rows of `state` (withoutBalls keeps the order; no clumps)
   for (std::size_t i = 0; i < p.size(); ++i)
     if (!remove[i]) loaded.push_back(loaded_before[i]);
+  // The elastic energy the parents' contacts (with balls and walls) store now, at
+  // the run's law and stiffness: what a breakage may hand back (CrowdedBound).
+  double parent_energy = 0;
+  for (std::size_t k = 0; k < touching.pairs.size(); ++k)
+    if (remove[touching.pairs[k].first] || remove[touching.pairs[k].second]) parent_energy += touching.pair_energy[k];
+  for (std::size_t k = 0; k < touching.walls.size(); ++k)
+    if (remove[touching.walls[k].first]) parent_energy += touching.wall_energy[k];
+  std::vector<std::uint32_t> run_row;  // row of `state` after the removal -> row of the run's balls
+  for (std::uint32_t i = 0; i < p.size(); ++i)
+    if (!remove[i]) run_row.push_back(i);
   state = sim::withoutBalls(std::move(state), remove);
   std::vector<std::uint32_t> rows;
   const std::size_t first_event = events_.size();
@@ -254,13 +276,43 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   loaded.resize(state.particles.size(), false);  // the fragments
   const crusher::FreezeResult freeze =
       crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads, loaded);
-  // A crowded freeze keeps its breakage with "break" while the overlap it leaves is
-  // within the bound (handed back at rock stiffness an overlap f R loads a ball to
-  // q = 0.9 E_c f: BreakageSettings); otherwise, and with "defer", the parents wait.
+  // What the freeze hands back: the run's World on the state after it (built here
+  // when the positions came back; it is the run's next World if the breakage is
+  // kept), and the elastic energy of the moved balls' contacts in it, at the run's
+  // law and stiffness, less what the moved neighbours' contacts other than with the
+  // parents held before (none for the local freeze: they touched only the parents).
+  std::unique_ptr<sim::World> next;
+  double handed_back = 0;
+  if (!freeze.movers.empty()) {
+    next = std::make_unique<sim::World>(model, std::move(state), ctx.threads);
+    std::vector<bool> moved(next->particles().size(), false), moved_before(p.size(), false);
+    for (const std::uint32_t m : freeze.movers) {
+      moved[m] = true;
+      if (m < run_row.size()) moved_before[run_row[m]] = true;  // an unbroken ball that moved
+    }
+    const sim::TouchingContacts after = next->touchingContacts();  // by the positions: no step yet
+    for (std::size_t k = 0; k < after.pairs.size(); ++k)
+      if (moved[after.pairs[k].first] || moved[after.pairs[k].second]) handed_back += after.pair_energy[k];
+    for (std::size_t k = 0; k < after.walls.size(); ++k)
+      if (moved[after.walls[k].first]) handed_back += after.wall_energy[k];
+    for (std::size_t k = 0; k < touching.pairs.size(); ++k) {
+      const auto [i, j] = touching.pairs[k];
+      if (!remove[i] && !remove[j] && (moved_before[i] || moved_before[j])) handed_back -= touching.pair_energy[k];
+    }
+    for (std::size_t k = 0; k < touching.walls.size(); ++k)
+      if (moved_before[touching.walls[k].first]) handed_back -= touching.wall_energy[k];
+  }
+  // A crowded freeze keeps its breakage with "break" within the bound
+  // (BreakageSettings::CrowdedBound): by energy, no more elastic energy handed back
+  // than the parents' contacts stored; by overlap, at most crowded_max_overlap
+  // (handed back at rock stiffness an overlap f R loads a ball to q = 0.9 E_c f).
+  // Otherwise, and with "defer", the parents wait.
   const bool crowded = freeze.end == crusher::FreezeEnd::Crowded;
+  const bool within_bound = s_.crowded_bound == BreakageSettings::CrowdedBound::Energy
+                                ? handed_back <= s_.crowded_energy_factor * parent_energy
+                                : freeze.max_overlap <= s_.crowded_max_overlap;
   const bool kept = freeze.end != crusher::FreezeEnd::Interrupted &&
-                    (!crowded || (s_.freeze.crowded == crusher::CrowdedOutcome::Break &&
-                                  freeze.max_overlap <= s_.crowded_max_overlap));
+                    (!crowded || (s_.freeze.crowded == crusher::CrowdedOutcome::Break && within_bound));
   if (!kept) {
     events_.resize(first_event);
     next_id_ = next_id_before;
@@ -269,7 +321,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     if (crowded) {
       // No room for the fragments: the parents stay whole for defer_time (0: until
       // the next check), then may break again where the chamber has moved on.
-      Deferral d{world->time(), {}, freeze.cycles, freeze.max_overlap};
+      Deferral d{world->time(), {}, freeze.cycles, freeze.max_overlap, parent_energy, handed_back};
       for (const Broken& b : broken) {
         d.parents.push_back(p.id[b.row]);
         deferred_until_[p.id[b.row]] = world->time() + s_.defer_time;
@@ -287,11 +339,13 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     events_[k].freeze_end = freeze.end;
     events_[k].freeze_overlap = freeze.max_overlap;
     events_[k].freeze_contact_times = contact_times;
+    events_[k].parent_energy = parent_energy;
+    events_[k].handed_back_energy = handed_back;
   }
+  const sim::ParticleState& q = next->particles();
   for (const std::uint32_t f : rows)
     jump_window = std::max(jump_window, kJumpWindow * std::numbers::pi *
-                                            std::sqrt(state.particles.mass[f] /
-                                                      model.materials[state.particles.material[f]].kn));
+                                            std::sqrt(q.mass[f] / next->model().materials[q.material[f]].kn));
   std::vector<std::uint32_t> all(p.size());
   std::iota(all.begin(), all.end(), 0u);
   jump_watch_ = JumpWatch{crusher::kineticEnergy(p, all), world->time() + jump_window, first_event, events_.size()};
@@ -301,14 +355,16 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   if (crowded) {
     ++freezes_crowded_;
     max_crowded_overlap_ = std::max(max_crowded_overlap_, freeze.max_overlap);
+    max_crowded_handed_back_ = std::max(max_crowded_handed_back_, handed_back);
   }
+  max_excess_ = std::max(max_excess_, handed_back - parent_energy);
   max_freeze_overlap_ = std::max(max_freeze_overlap_, freeze.max_overlap);
   freeze_cycles_ += freeze.cycles;
   max_freeze_cycles_ = std::max(max_freeze_cycles_, freeze.cycles);
   max_freeze_balls_ = std::max(max_freeze_balls_, freeze.balls);
   reach_widenings_ += static_cast<std::uint64_t>(freeze.reach_widenings);
   moved_neighbours_ += freeze.moved_neighbours;
-  world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
+  world = std::move(next);
   return true;
 }
 
@@ -339,13 +395,14 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   std::ostringstream csv;
   csv.precision(17);
   csv << "time_s,parent_id,diameter_mm,q_MPa,strength_MPa,mode,fragment_ids,freeze_cycles,freeze_end,"
-         "freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J\n";
+         "freeze_overlap_fraction,freeze_contact_times,kinetic_jump_J,parent_energy_J,handed_back_energy_J\n";
   for (const BreakageEvent& e : events_) {
     csv << e.time << ',' << e.parent << ',' << e.diameter * 1e3 << ',' << e.q * 1e-6 << ',' << e.strength * 1e-6 << ','
         << crusher::modeName(s_.mode) << ',';
     for (std::size_t k = 0; k < e.fragments.size(); ++k) csv << (k ? ";" : "") << e.fragments[k];
     csv << ',' << e.freeze_cycles << ',' << crusher::freezeEndName(e.freeze_end) << ',' << e.freeze_overlap << ','
-        << e.freeze_contact_times << ',' << e.kinetic_jump << '\n';
+        << e.freeze_contact_times << ',' << e.kinetic_jump << ',' << e.parent_energy << ','
+        << e.handed_back_energy << '\n';
   }
   double max_jump = 0, max_crowded_jump = 0;
   for (const BreakageEvent& e : events_) {
@@ -369,6 +426,13 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["max_crowded_kinetic_jump_J"] = max_crowded_jump;
   b["freeze_crowded"] = crusher::crowdedOutcomeName(s_.freeze.crowded);
   b["freeze_crowded_max_overlap"] = s_.crowded_max_overlap;
+  b["freeze_crowded_bound"] = crowdedBoundName(s_.crowded_bound);
+  b["freeze_crowded_energy_factor"] = s_.crowded_energy_factor;
+  // J: the most a kept crowded freeze handed back, and over every kept freeze the
+  // largest excess of what it handed back over what its parents stored (<= 0: no
+  // elastic energy created by any breakage).
+  b["max_crowded_handed_back_energy_J"] = max_crowded_handed_back_;
+  b["max_handed_back_excess_J"] = freezes_ > 0 ? nlohmann::json(max_excess_) : nlohmann::json(nullptr);
   b["freeze_max_contact_times"] = s_.freeze.max_contact_times;
   b["freeze_scope"] = crusher::freezeScopeName(s_.freeze.scope);
   b["max_freeze_balls"] = max_freeze_balls_;
@@ -377,7 +441,8 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   nlohmann::json deferred = nlohmann::json::array();
   for (const Deferral& d : deferrals_)
     deferred.push_back({{"time_s", d.time}, {"parents", d.parents}, {"freeze_cycles", d.cycles},
-                        {"overlap_fraction", d.overlap}});
+                        {"overlap_fraction", d.overlap}, {"parent_energy_J", d.parent_energy},
+                        {"handed_back_energy_J", d.handed_back_energy}});
   b["deferred"] = deferred;
   b["defer_time_s"] = s_.defer_time;
   b["check_interval_s"] = check_interval_;

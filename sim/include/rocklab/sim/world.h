@@ -104,12 +104,16 @@ struct WorldStats {
 
 /// The contacts that touch (overlap > 0) in the state at the current time: ball
 /// pairs (first < second) and ball–wall contacts (ball, wall index), each with
-/// its overlap (m, the one the contact law sees).
+/// its overlap (m, the one the contact law sees) and the elastic energy its
+/// springs store (J, normal and shear, at the World's law and stiffnesses: the
+/// energy log's per-contact term).
 struct TouchingContacts {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   std::vector<double> pair_overlap;
+  std::vector<double> pair_energy;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> walls;
   std::vector<double> wall_overlap;
+  std::vector<double> wall_energy;
 };
 
 class World {
@@ -164,8 +168,11 @@ class World {
   /// the dashpots' share is left out). A platen's load cell.
   std::vector<Vec3> wallForces() const;
   /// Which balls touch which balls and walls, from the contacts of the last step
-  /// (the ones particleStress sums; empty before the first step). The crusher's
-  /// freeze tells load-bearing neighbours from loose ones with it.
+  /// (the ones particleStress sums). Before the first step: none in a World built
+  /// from spheres; in one built from a saved state, the pairs and walls its
+  /// positions overlap (what the first step's force pass will find), with the
+  /// saved shear springs. The crusher's freeze tells load-bearing neighbours from
+  /// loose ones with it, and bounds what a crowded breakage hands back by its energies.
   TouchingContacts touchingContacts() const;
   /// Work (J) the moving walls have done on the balls (WorldState::moving_wall_work
   /// says since when): every step, each wall contact's force, dashpots included,
