@@ -97,10 +97,12 @@ namespace {
 void writeProductCurves(const std::filesystem::path& dir, const SweepOptions& o, const std::vector<Variant>& done,
                         const std::string& name, std::ostream& log) {
   PlotSpec spec = sieveChart(name + ": product size distribution of each run");
+  // A row that is not {size_mm, passing} (a damaged results.json) is a gap in the line.
   auto curve = [](const json& psd, PlotSeries& s) {
     for (const json& row : psd) {
-      s.x.push_back(number(row.value("size_mm", json())));
-      s.y.push_back(100 * number(row.value("passing", json())));
+      const bool ok = row.is_object();
+      s.x.push_back(ok ? number(row.value("size_mm", json())) : std::numeric_limits<double>::quiet_NaN());
+      s.y.push_back(ok ? 100 * number(row.value("passing", json())) : std::numeric_limits<double>::quiet_NaN());
     }
   };
   for (const Variant& p : done) {
