@@ -91,6 +91,19 @@ namespace {
 // chamber's own changes (the mantle's work, other impacts).
 constexpr double kJumpWindow = 5;
 
+/// Adds sign × the elastic energy (J) of the contacts in `c` that involve a ball
+/// flagged in `balls` and none flagged in `skip` (empty: none), pairs then walls.
+void addContactEnergy(double& sum, double sign, const sim::TouchingContacts& c, const std::vector<bool>& balls,
+                      const std::vector<bool>& skip = {}) {
+  const auto skipped = [&](std::uint32_t i) { return !skip.empty() && skip[i]; };
+  for (std::size_t k = 0; k < c.pairs.size(); ++k) {
+    const auto [i, j] = c.pairs[k];
+    if ((balls[i] || balls[j]) && !skipped(i) && !skipped(j)) sum += sign * c.pair_energy[k];
+  }
+  for (std::size_t k = 0; k < c.walls.size(); ++k)
+    if (balls[c.walls[k].first] && !skipped(c.walls[k].first)) sum += sign * c.wall_energy[k];
+}
+
 std::string mm(double metres) {
   std::ostringstream s;
   s.precision(4);
@@ -238,10 +251,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   // The elastic energy the parents' contacts (with balls and walls) store now, at
   // the run's law and stiffness: what a breakage may hand back (CrowdedBound).
   double parent_energy = 0;
-  for (std::size_t k = 0; k < touching.pairs.size(); ++k)
-    if (remove[touching.pairs[k].first] || remove[touching.pairs[k].second]) parent_energy += touching.pair_energy[k];
-  for (std::size_t k = 0; k < touching.walls.size(); ++k)
-    if (remove[touching.walls[k].first]) parent_energy += touching.wall_energy[k];
+  addContactEnergy(parent_energy, 1.0, touching, remove);
   std::vector<std::uint32_t> run_row;  // row of `state` after the removal -> row of the run's balls
   for (std::uint32_t i = 0; i < p.size(); ++i)
     if (!remove[i]) run_row.push_back(i);
@@ -290,17 +300,8 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
       moved[m] = true;
       if (m < run_row.size()) moved_before[run_row[m]] = true;  // an unbroken ball that moved
     }
-    const sim::TouchingContacts after = next->touchingContacts();  // by the positions: no step yet
-    for (std::size_t k = 0; k < after.pairs.size(); ++k)
-      if (moved[after.pairs[k].first] || moved[after.pairs[k].second]) handed_back += after.pair_energy[k];
-    for (std::size_t k = 0; k < after.walls.size(); ++k)
-      if (moved[after.walls[k].first]) handed_back += after.wall_energy[k];
-    for (std::size_t k = 0; k < touching.pairs.size(); ++k) {
-      const auto [i, j] = touching.pairs[k];
-      if (!remove[i] && !remove[j] && (moved_before[i] || moved_before[j])) handed_back -= touching.pair_energy[k];
-    }
-    for (std::size_t k = 0; k < touching.walls.size(); ++k)
-      if (moved_before[touching.walls[k].first]) handed_back -= touching.wall_energy[k];
+    addContactEnergy(handed_back, 1.0, next->touchingContacts(), moved);  // by the positions: no step yet
+    addContactEnergy(handed_back, -1.0, touching, moved_before, remove);  // a moved ball is never a parent
   }
   // A crowded freeze keeps its breakage with "break" within the bound
   // (BreakageSettings::CrowdedBound): by energy, no more elastic energy handed back
