@@ -49,6 +49,9 @@ StepPlan World::Impl::planStep(bool observed) const {
 }
 
 void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
+  // The engine's own wall time (the observer's is the caller's), for the team tuner.
+  const auto start = std::chrono::steady_clock::now();
+  double observer_seconds = 0.0;
   {
     StageTimer timer(stageSeconds(Stage::Prepare));
     prepareStage();  // 1
@@ -82,13 +85,25 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
   }
   if (observer) {
     // The whole-step snapshot, before the kick; the observer's own time is the caller's.
+    const auto observer_start = std::chrono::steady_clock::now();
     std::vector<Vec3> total_force;
     std::vector<std::uint8_t> wall_active;
     observer(snapshot(total_force, wall_active));
+    observer_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - observer_start).count();
   }
-  StageTimer timer(stageSeconds(Stage::Integrate));
-  integrateStage(plan, checks);  // 8
-  finishStep(checks);
+  {
+    StageTimer timer(stageSeconds(Stage::Integrate));
+    integrateStage(plan, checks);  // 8
+    finishStep(checks);
+  }
+  if (team_policy == TeamPolicy::Adaptive && fullTeam() > 1) {
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - observer_seconds;
+    if (tuner.stepDone(seconds)) teamChanged();
+    stats.team_probes = tuner.probes();
+    stats.team_switches = tuner.switches();
+    stats.single_thread_steps = tuner.singleSteps();
+  }
 }
 
 void World::step(const std::function<void(const Snapshot&)>& observer) { impl_->doStep(observer); }
@@ -111,6 +126,11 @@ const ParticleState& World::particles() const { return impl_->p; }
 const TimestepAudit& World::timestepAudit() const { return impl_->audit; }
 const WorldStats& World::stats() const { return impl_->stats; }
 int World::threads() const { return impl_->teamSize(); }
+int World::fullTeam() const { return impl_->fullTeam(); }
+void World::setTeamPolicy(TeamPolicy policy) {
+  impl_->team_policy = policy;
+  impl_->teamChanged();
+}
 int World::bondThreads() const { return impl_->bondTeamSize(); }
 Vec3 World::gravity() const { return impl_->gravity; }
 const BondState& World::bonds() const { return impl_->bonds.state; }

@@ -15,6 +15,7 @@
 #include "contact_kernel.h"
 #include "contact_spectrum.h"
 #include "neighbor_list.h"
+#include "team_tuner.h"
 #include "rocklab/sim/world.h"
 #include "wall_runtime.h"
 
@@ -207,6 +208,8 @@ struct World::Impl {
     std::vector<std::uint32_t> range_begin;  // [team+1] balls of each thread
     std::vector<std::uint32_t> cross_index;  // [pairs] slot of a pair crossing two ranges, or kNotCross
     std::vector<CrossSlot> cross;
+    std::vector<std::uint32_t> cross_begin;  // [team+1] slots of each thread's phase A
+    std::vector<std::uint32_t> cross_ball, cross_pair;  // [slots] first ball and pair of each slot
     std::vector<Vec3> acc_force, acc_torque;  // [n] N, N m: contacts and contributions, no gravity
   } scratch;
 
@@ -265,9 +268,22 @@ struct World::Impl {
   // ran 1.65x slower on 2 threads, while 2000 lattice balls ran 1.7x faster, and
   // 16000 balls 1.5-1.9x faster). Results are bitwise the same whatever the team.
   static constexpr std::size_t kMinBallsPerThread = 2500;
-  int teamSize() const {
+  int fullTeam() const {
     const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
     return std::max(1, std::min(threads, useful));
+  }
+  // The team of this step: the full team or one thread, as the policy (and, when
+  // adaptive, the tuner's timing: team_tuner.h) says.
+  TeamPolicy team_policy = TeamPolicy::Adaptive;
+  detail::TeamTuner tuner;
+  int teamSize() const {
+    const bool single = team_policy == TeamPolicy::Single ||
+                        (team_policy == TeamPolicy::Adaptive && tuner.single());
+    return single ? 1 : fullTeam();
+  }
+  /// The force pass's ranges follow a change of team made between two steps.
+  void teamChanged() {
+    if (!nb.need_rebuild && !scratch.range_begin.empty()) assignRanges();
   }
   // The bond stage has its own team: a bond costs a few contact evaluations, so
   // a small agglomerate with many bonds pays a second thread where its balls
@@ -275,6 +291,7 @@ struct World::Impl {
   static constexpr std::size_t kMinBondsPerThread = 2000;
   int bondTeamSize() const {
     const auto useful = static_cast<int>(bonds.state.size() / kMinBondsPerThread);
+    if (teamSize() == 1 && fullTeam() > 1) return 1;  // one thread chosen (tuner or policy)
     return std::max(teamSize(), std::min(threads, useful));  // teamSize() >= 1
   }
   const detail::PairProps& pairProps(std::size_t i, std::size_t j) const {
@@ -365,24 +382,31 @@ struct World::Impl {
 
 /// Kick and drift of one free ball (Eq 2-11..2-13, local damping Eq 2-15).
 /// Inline: the contact pass (stage 3) fuses it on unobserved steps.
-inline void World::Impl::integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque, double h,
-                                   StepChecks& c) {
+[[gnu::always_inline]] inline void World::Impl::integrate(std::size_t i, const Vec3& f_contact, const Vec3& torque,
+                                                         double h, StepChecks& c) {
   const double inv_m = p.inv_mass[i];
   Vec3 f = f_contact + gravity / inv_m;  // generalised force incl. gravity (Eq 2-14)
   Vec3 t = torque;
+  // The new state is formed in registers and checked there, then stored once:
+  // reading back what was just stored (a 16- plus an 8-byte store read as
+  // doubles) stalled on store forwarding and cost a third of a sparse scene's step.
+  Vec3 v = p.velocity[i], w = p.omega[i];
   const double alpha = model.contact.local_damping;
   if (alpha > 0) {
     // Cundall's local damping, Eq 2-15 in its sign form: -alpha |F| sign(v) per component.
     for (int a = 0; a < 3; ++a) {
-      f[a] -= alpha * std::abs(f[a]) * ((p.velocity[i][a] > 0) - (p.velocity[i][a] < 0));
-      t[a] -= alpha * std::abs(t[a]) * ((p.omega[i][a] > 0) - (p.omega[i][a] < 0));
+      f[a] -= alpha * std::abs(f[a]) * ((v[a] > 0) - (v[a] < 0));
+      t[a] -= alpha * std::abs(t[a]) * ((w[a] > 0) - (w[a] < 0));
     }
   }
-  p.velocity[i] += (h * inv_m) * f;          // Eq 2-11
-  p.omega[i] += (h * p.inv_inertia[i]) * t;  // Eq 2-12 (sphere: no gyroscopic term)
-  p.position[i] += dt * p.velocity[i];       // Eq 2-13
-  if (!p.position[i].allFinite() || !p.velocity[i].allFinite()) c.non_finite = true;
-  c.max_disp2 = std::max(c.max_disp2, (p.position[i] - nb.ref_position[i]).squaredNorm());
+  v += (h * inv_m) * f;                   // Eq 2-11
+  w += (h * p.inv_inertia[i]) * t;        // Eq 2-12 (sphere: no gyroscopic term)
+  const Vec3 x = p.position[i] + dt * v;  // Eq 2-13
+  if (!x.allFinite() || !v.allFinite()) c.non_finite = true;
+  c.max_disp2 = std::max(c.max_disp2, (x - nb.ref_position[i]).squaredNorm());
+  p.velocity[i] = v;
+  p.omega[i] = w;
+  p.position[i] = x;
 }
 
 }  // namespace rocklab::sim

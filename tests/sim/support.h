@@ -31,6 +31,7 @@ struct BreakingRun {
 inline BreakingRun runWithBreaks(const sim::Model& model, const std::vector<sim::SphereSpec>& spheres,
                                  const std::vector<sim::BondSpec>& bonds, int threads, int steps = 400) {
   sim::World world(model, spheres, {}, bonds, threads);
+  world.setTeamPolicy(sim::TeamPolicy::Full);  // the full team throughout: what the tests compare
   for (int s = 0; s < steps; ++s)  // every 50th step observed, as outputs would
     world.step(s % 50 == 0 ? [](const sim::Snapshot&) {} : std::function<void(const sim::Snapshot&)>{});
   BreakingRun r{world.stateHash(), {}, world.threads(), world.bondThreads()};

@@ -177,6 +177,7 @@ TEST_CASE("clump: bitwise identical on 1 and 2 threads and across a restart", "[
   std::uint64_t hash[2];
   for (int t : {1, 2}) {
     sim::World w(model, {}, clumps, t);
+    w.setTeamPolicy(sim::TeamPolicy::Full);  // no timed switch to one thread
     REQUIRE(w.threads() == t);
     for (int k = 0; k < 400; ++k) w.step();
     hash[t - 1] = w.stateHash();

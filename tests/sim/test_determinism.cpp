@@ -9,6 +9,7 @@
 #include "rocklab/geometry/packing.h"
 #include "rocklab/sim/output/checkpoint.h"
 #include "support.h"
+#include "team_tuner.h"
 
 using namespace rocklab;
 using test::Vec3;
@@ -45,6 +46,7 @@ TEST_CASE("bitwise identical on 1 and 2 threads", "[determinism]") {
   REQUIRE(granted == 2);
   for (int t : {1, 2}) {
     sim::World w(heapModel(), s, t);
+    w.setTeamPolicy(sim::TeamPolicy::Full);  // no timed switch to one thread
     REQUIRE(w.threads() == t);
     for (int k = 0; k < 300; ++k) w.step();
     hash[t - 1] = w.stateHash();
@@ -108,4 +110,56 @@ TEST_CASE("relaxation offsets survive a checkpoint file: read back, the restart 
   sim::World second(model, std::move(cp.state), 1);
   while (second.stepCount() < 6000) second.step();
   CHECK(second.stateHash() == full.stateHash());
+}
+
+TEST_CASE("switching between the full team and one thread mid-run changes no bit", "[determinism]") {
+  // What the adaptive team (TeamPolicy::Adaptive, team_tuner.h) does when it
+  // finds one thread faster: here forced at uneven intervals, across neighbour
+  // rebuilds, against a run on one thread throughout.
+  const auto s = lattice(30, 20, 10);
+  sim::World one(heapModel(), s, 1);
+  sim::World mixed(heapModel(), s, 2);
+  REQUIRE(mixed.fullTeam() == 2);
+  int single_steps = 0;
+  for (int k = 0; k < 300; ++k) {
+    if (k % 37 == 0) mixed.setTeamPolicy((k / 37) % 2 ? sim::TeamPolicy::Single : sim::TeamPolicy::Full);
+    single_steps += mixed.threads() == 1;
+    one.step();
+    mixed.step();
+  }
+  CHECK(single_steps > 100);
+  CHECK(single_steps < 200);
+  CHECK(mixed.stats().neighbour_rebuilds > 1);
+  CHECK(mixed.stateHash() == one.stateHash());
+}
+
+TEST_CASE("the adaptive team keeps the faster of the full team and one thread", "[determinism]") {
+  // The tuner alone, fed step times: it measures a window on its team, probes
+  // the other, switches only for a margin, and probes less often while its
+  // choice holds.
+  sim::detail::TeamTuner tuner;
+  using T = sim::detail::TeamTuner;
+  auto run = [&](double full_step, double single_step, double seconds) {
+    for (double t = 0; t < seconds;) {
+      const double dt = tuner.single() ? single_step : full_step;
+      tuner.stepDone(dt);
+      t += dt;
+    }
+  };
+  REQUIRE(!tuner.single());
+  run(1e-3, 1.8e-3, 1.0);  // an idle machine: two threads are faster
+  CHECK(!tuner.single());
+  CHECK(tuner.switches() == 0);
+  CHECK(tuner.probes() >= 1);
+  run(2.0e-3, 1.2e-3, 10.0);  // another process takes a core: one thread is faster
+  CHECK(tuner.single());
+  CHECK(tuner.switches() == 1);
+  const auto probes = tuner.probes();
+  run(2.0e-3, 1.99e-3, 100.0);  // within the margin: it stays, probing ever less often
+  CHECK(tuner.single());
+  CHECK(tuner.switches() == 1);
+  CHECK(tuner.probes() - probes < 100.0 / T::kFirstInterval / 2);
+  run(1e-3, 1.8e-3, 2 * T::kMaxInterval + 1);  // the core is free again: back to the team
+  CHECK(!tuner.single());
+  CHECK(tuner.switches() == 2);
 }

@@ -112,6 +112,7 @@ TEST_CASE("force contribution: the extra-forces stage is bitwise the same on one
     }
   auto run = [&](int threads, bool springs) {
     sim::World w(model, balls, threads);
+    w.setTeamPolicy(sim::TeamPolicy::Full);  // no timed switch to one thread
     if (springs) w.addForceContribution(std::make_shared<TestSprings>(links, 200.0));
     for (int s = 0; s < 300; ++s) w.step(s % 50 == 0 ? [](const sim::Snapshot&) {} : std::function<void(const sim::Snapshot&)>{});
     return std::pair{w.stateHash(), w.threads()};

@@ -127,7 +127,11 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   if (!scene.clump_shapes.empty()) r["clump_shapes"] = clumpShapesJson(scene.clump_shapes);
   r["walls"] = world.model().walls.size();
   r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
-  r["threads"] = world.threads();
+  r["threads"] = world.fullTeam();
+  // Steps the adaptive team ran on one thread because it timed faster (sim/src/team_tuner.h).
+  r["team"] = {{"probes", world.stats().team_probes},
+               {"switches", world.stats().team_switches},
+               {"single_thread_steps", world.stats().single_thread_steps}};
   // How waiting OpenMP threads behave (app/main.cpp sets a short spin unless the user chose).
   const char* wait_policy = std::getenv("OMP_WAIT_POLICY");
   const char* spin_count = std::getenv("GOMP_SPINCOUNT");

@@ -137,7 +137,7 @@ void logSetup(const Scene& scene, const RunSetup& setup, const RunOptions& optio
   log << "rocklab: scene '" << scene.run.name << "'"
       << (options.restart.empty() ? "" : " (restart)") << ", " << world.particles().size()
       << " balls (" << world.particles().clumps.size() << " clumps), " << model.walls.size()
-      << " walls, threads: " << world.threads() << "\n";
+      << " walls, threads: " << world.fullTeam() << "\n";
   log << "  modules: ";
   for (std::size_t k = 0; k < setup.modules.size(); ++k) log << (k ? ", " : "") << setup.modules[k];
   log << "\n";

@@ -24,6 +24,7 @@ namespace rocklab::sim {
 template <class Law>
 [[gnu::always_inline]] inline bool World::Impl::evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj,
                                       Vec3& tj, StepChecks& c) {
+  const bool damped = model.contact.damping_normal > 0 || model.contact.damping_shear > 0;
   const std::uint32_t j = nb.pairs.partner[k];
   const Vec3 xi = p.position[i];
   const double ri = p.radius[i], rj = p.radius[j];
@@ -50,8 +51,8 @@ template <class Law>
   const Vec3 ai = cp - xi, aj = cp - p.position[j];
   g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
   g.r_tilde = effectiveRadius(ri, rj);  // Eq 2-24
-  const double mi = p.mass[i], mj = p.mass[j];
-  g.damping_mass = detail::dampingMass(model.contact.damping_mass, mi, mj);
+  // Only the dashpots read it: a division per contact saved on undamped scenes.
+  g.damping_mass = damped ? detail::dampingMass(model.contact.damping_mass, p.mass[i], p.mass[j]) : 0.0;
   const detail::ContactResult res = detail::evaluateContact<Law>(pairProps(i, j), model.contact, g, dt, history.pair_shear[k]);
   fi = res.force;
   ti = ai.cross(res.force);
@@ -123,14 +124,15 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
     const int th = omp_get_thread_num();
     const std::uint32_t b = scratch.range_begin[th], e = scratch.range_begin[th + 1];
     StepChecks local;
-    // Phase A: pairs whose second ball belongs to a later range.
-    for (std::uint32_t i = b; i < e; ++i)
-      for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
-        if (nb.pairs.partner[k] < e) continue;
-        ForceScratch::CrossSlot& s = scratch.cross[scratch.cross_index[k]];
-        evaluatePair<Law>(i, k, s.fi, s.ti, s.fj, s.tj, local);
+    // Phase A: pairs whose second ball belongs to a later range (their slots are
+    // the thread's, in the order of its rows; none on one thread).
+    if (crossing) {
+      for (std::uint32_t s = scratch.cross_begin[th]; s < scratch.cross_begin[th + 1]; ++s) {
+        ForceScratch::CrossSlot& slot = scratch.cross[s];
+        evaluatePair<Law>(scratch.cross_ball[s], scratch.cross_pair[s], slot.fi, slot.ti, slot.fj, slot.tj, local);
       }
 #pragma omp barrier
+    }
     // Phase B: start every ball of the range with the cross contributions it
     // receives (pairs (i', p), i' < b, ascending i').
     for (std::uint32_t q = b; q < e; ++q) {

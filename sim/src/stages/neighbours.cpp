@@ -95,18 +95,28 @@ void World::Impl::assignRanges() {
   for (int t = 0; t <= team; ++t) scratch.range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
   // One thread has no pair crossing two ranges: no slot index (4 bytes a pair).
   if (team == 1) {
-    scratch.cross_index.clear();
-    scratch.cross_index.shrink_to_fit();
+    for (auto* v : {&scratch.cross_index, &scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair}) {
+      v->clear();
+      v->shrink_to_fit();
+    }
     scratch.cross.clear();
     return;
   }
   scratch.cross_index.assign(nb.pairs.size(), ForceScratch::kNotCross);
-  std::uint32_t slots = 0;
-  for (int t = 0; t < team; ++t)
+  scratch.cross_begin.assign(1, 0);
+  scratch.cross_ball.clear();
+  scratch.cross_pair.clear();
+  for (int t = 0; t < team; ++t) {
     for (std::uint32_t i = scratch.range_begin[t]; i < scratch.range_begin[t + 1]; ++i)
       for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k)
-        if (nb.pairs.partner[k] >= scratch.range_begin[t + 1]) scratch.cross_index[k] = slots++;
-  scratch.cross.resize(slots);
+        if (nb.pairs.partner[k] >= scratch.range_begin[t + 1]) {
+          scratch.cross_index[k] = static_cast<std::uint32_t>(scratch.cross_pair.size());
+          scratch.cross_ball.push_back(i);
+          scratch.cross_pair.push_back(k);
+        }
+    scratch.cross_begin.push_back(static_cast<std::uint32_t>(scratch.cross_pair.size()));
+  }
+  scratch.cross.resize(scratch.cross_pair.size());
 }
 
 }  // namespace rocklab::sim

@@ -100,7 +100,18 @@ struct WorldStats {
   // ball unseen), and the first of them described (ball, time, distance).
   std::uint64_t far_travel_steps = 0;
   std::string far_travel;
+  // TeamPolicy::Adaptive (a team of two or more): timing probes of the other
+  // team, switches between the full team and one thread, and steps run on one.
+  std::uint64_t team_probes = 0;
+  std::uint64_t team_switches = 0;
+  std::uint64_t single_thread_steps = 0;
 };
+
+/// The threads a step runs on. Results are bitwise the same on any team, so this
+/// decides only the wall time. Adaptive (the default) times the full team
+/// against one thread now and then and runs on the faster: one thread wins when
+/// another process holds a core (sim/src/team_tuner.h). Full and Single pin it.
+enum class TeamPolicy { Adaptive, Full, Single };
 
 /// The contacts that touch (overlap > 0) in the state at the current time: ball
 /// pairs (first < second) and ball–wall contacts (ball, wall index), each with
@@ -146,8 +157,13 @@ class World {
   const ParticleState& particles() const;
   const TimestepAudit& timestepAudit() const;
   const WorldStats& stats() const;
-  /// Threads the step really uses: the requested ones, fewer for small worlds.
+  /// Threads the next step uses: the full team, or one where the team policy
+  /// (setTeamPolicy) chose one thread.
   int threads() const;
+  /// The full team: the requested threads, fewer for small worlds.
+  int fullTeam() const;
+  /// TeamPolicy::Adaptive unless set; takes effect at the next step.
+  void setTeamPolicy(TeamPolicy policy);
   /// Threads the bond stage uses: as many as threads(), more for many bonds.
   int bondThreads() const;
   Vec3 gravity() const;
