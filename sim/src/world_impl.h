@@ -312,7 +312,12 @@ struct World::Impl {
   // Set-up (world_setup.cpp).
   void initialise(int requested_threads);
   void buildPairProps();
-  void placeMembers(std::size_t c);
+  /// Members' positions, velocities and spins from their body's; returns the
+  /// largest squared displacement of a member since the last rebuild (m^2; 0 before one).
+  double placeMembers(std::size_t c);
+  /// The same from the body's state given (the integrator's registers: reading
+  /// back what it just stored stalls on store forwarding).
+  double placeMembers(std::size_t c, const Quat& q, const Vec3& centre, const Vec3& v, const Vec3& L);
   void restoreHistory(const WorldState& state);
 
   // One step (world.cpp): the stages in order.

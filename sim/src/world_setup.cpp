@@ -337,17 +337,29 @@ void World::Impl::buildPairProps() {
 }
 
 /// Sets the members' positions, velocities and spins from their clump's state.
-void World::Impl::placeMembers(std::size_t c) {
-  ClumpState& k = p.clumps;
-  const Quat q = k.orientation[c];
-  const Vec3 w = detail::angularVelocity(q, k.inertia[c], k.angular_momentum[c]);
+double World::Impl::placeMembers(std::size_t c) {
+  const ClumpState& k = p.clumps;
+  return placeMembers(c, k.orientation[c], k.position[c], k.velocity[c], k.angular_momentum[c]);
+}
+
+double World::Impl::placeMembers(std::size_t c, const Quat& q, const Vec3& centre, const Vec3& v, const Vec3& L) {
+  const ClumpState& k = p.clumps;
+  // One rotation matrix for the body's members and spin: cheaper than turning
+  // each vector by the quaternion.
+  const geometry::Mat3 R = q.toRotationMatrix();
+  const Vec3 w = detail::angularVelocity(R, k.inertia[c], L);
+  double max_disp2 = 0.0;
   for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
     const std::uint32_t i = k.member_ball[m];
-    const Vec3 arm = q * k.member_offset[m];
-    p.position[i] = k.position[c] + arm;
-    p.velocity[i] = k.velocity[c] + w.cross(arm);
+    const Vec3 arm = R * k.member_offset[m];
+    const Vec3 x = centre + arm;
+    // From the registers, not read back from the stores (a store-forwarding stall).
+    if (!nb.ref_position.empty()) max_disp2 = std::max(max_disp2, (x - nb.ref_position[i]).squaredNorm());
+    p.position[i] = x;
+    p.velocity[i] = v + w.cross(arm);
     p.omega[i] = w;
   }
+  return max_disp2;
 }
 
 }  // namespace rocklab::sim

@@ -66,17 +66,18 @@ void World::Impl::integrateClumps(double h, StepChecks& merged) {
           t[a] -= alpha * std::abs(t[a]) * ((w[a] > 0) - (w[a] < 0));
         }
       }
-      k.velocity[c] += (h / k.mass[c]) * f;     // Eq 2-11 for the body
-      k.angular_momentum[c] += h * t;           // Eq 2-45
-      k.position[c] += dt * k.velocity[c];      // Eq 2-13
-      detail::rotateFree(k.orientation[c], k.inertia[c], k.angular_momentum[c], dt);
-      placeMembers(c);
-      if (!k.position[c].allFinite() || !k.velocity[c].allFinite() || !k.angular_momentum[c].allFinite())
-        local.non_finite = true;
-      for (std::uint32_t m = k.member_begin[c]; m < k.member_begin[c + 1]; ++m) {
-        const std::uint32_t i = k.member_ball[m];
-        local.max_disp2 = std::max(local.max_disp2, (p.position[i] - nb.ref_position[i]).squaredNorm());
-      }
+      // Formed and checked in registers, then stored (as integrate() does for a ball).
+      const Vec3 v = k.velocity[c] + (h / k.mass[c]) * f;  // Eq 2-11 for the body
+      const Vec3 L = k.angular_momentum[c] + h * t;         // Eq 2-45
+      const Vec3 x = k.position[c] + dt * v;                // Eq 2-13
+      if (!x.allFinite() || !v.allFinite() || !L.allFinite()) local.non_finite = true;
+      k.velocity[c] = v;
+      k.angular_momentum[c] = L;
+      k.position[c] = x;
+      Quat q = k.orientation[c];
+      detail::rotateFree(q, k.inertia[c], L, dt);
+      k.orientation[c] = q;
+      local.max_disp2 = std::max(local.max_disp2, placeMembers(c, q, x, v, L));
     }
 #pragma omp critical
     mergeChecks(merged, local);
