@@ -2,6 +2,7 @@
 // triangle indices that are not indices, particle counts past what memory or random
 // insertion allows. Each class: one message with file:line, key, value and why.
 #include <catch2/catch.hpp>
+#include <filesystem>
 #include <string>
 
 #include "rocklab/experiments/scene.h"
@@ -92,4 +93,30 @@ TEST_CASE("particle sources stay within the ball cap and what random insertion r
   msg = errorOf(scene("\"t\"", "\n[[particles]]\ntype = \"random\"\nmaterial = \"rock\"\nradius = 0.01\n"
                                "region_min = [0, 0, 0]\nregion_max = [0.2, 0.2, 0.2]\nsolid_fraction = 0.3\n"));
   CHECK_THAT(msg, Contains("spheres fit in the region without overlap (random insertion stopped at a solid fraction of 0."));
+}
+
+TEST_CASE("a built-in scene's name opens the built-in even where a folder of that name exists", "[scene]") {
+  // `rocklab run drop --out drop`, then `rocklab run drop` in the same folder: the
+  // outputs' folder shadowed the built-in ("drop: is a directory, not a scene file").
+  namespace fs = std::filesystem;
+  const fs::path here = fs::current_path();
+  const fs::path dir = fs::temp_directory_path() / "rocklab-builtin-shadow";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "drop");
+  fs::current_path(dir);
+  const fs::path resolved = resolveScene("drop");
+  const fs::path missing = resolveScene("no-such-scene");
+  fs::create_directories(dir / "mine");
+  std::string folder_error;
+  try {
+    loadScene(resolveScene("mine"), {});
+  } catch (const SceneError& e) {
+    folder_error = e.what();
+  }
+  fs::current_path(here);
+  fs::remove_all(dir);
+  CHECK(resolved == builtinSceneDir() / "drop.toml");
+  CHECK(missing == fs::path("no-such-scene"));
+  // A folder that is no built-in's name is still refused as a folder.
+  CHECK_THAT(folder_error, Contains("mine: is a directory, not a scene file"));
 }

@@ -139,7 +139,10 @@ std::filesystem::path builtinSceneDir() {
 
 std::filesystem::path resolveScene(const std::string& name_or_path) {
   const std::filesystem::path p(name_or_path);
-  if (std::filesystem::exists(p)) return p;
+  // A folder of that name is no scene: after `rocklab run drop --out drop` the next
+  // `rocklab run drop` in the same folder means the built-in drop, not the outputs.
+  std::error_code ec;
+  if (std::filesystem::exists(p, ec) && !std::filesystem::is_directory(p, ec)) return p;
   if (p.extension().empty() && p.parent_path().empty()) {
     const auto builtin = builtinSceneDir() / (name_or_path + ".toml");
     if (std::filesystem::exists(builtin)) return builtin;
