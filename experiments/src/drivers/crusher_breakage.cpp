@@ -343,6 +343,9 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     events_[k].parent_energy = parent_energy;
     events_[k].handed_back_energy = handed_back;
   }
+  // A kept breakage has movers today (the fragments, or every ball in "all"); were
+  // one to come back with none, its state is still the run's next World.
+  if (!next) next = std::make_unique<sim::World>(model, std::move(state), ctx.threads);
   const sim::ParticleState& q = next->particles();
   for (const std::uint32_t f : rows)
     jump_window = std::max(jump_window, kJumpWindow * std::numbers::pi *
