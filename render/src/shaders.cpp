@@ -20,6 +20,7 @@ uniform vec2 canvasSize;                    // pixels
 uniform int asQuads;                        // 0: one point per sphere, 1: a 4-vertex strip per sphere
 flat out vec4 vSphere;
 flat out vec3 vColour;
+flat out float vInverseRadius;
 // Pixel (u, v) → NDC: the pixel centre is at window (u + 0.5, v + 0.5), see view.cpp.
 vec2 ndc(vec2 pixel) { return 2.0 * (pixel + 0.5) / canvasSize - 1.0; }
 void main() {
@@ -33,46 +34,54 @@ void main() {
   }
   vSphere = centreRadius;
   vColour = colour.rgb;
+  vInverseRadius = 1.0 / centreRadius.w;
 }
 )";
 
 const char* const kSphereFragmentShader = R"(#version 330 core
 flat in vec4 vSphere;
 flat in vec3 vColour;
-uniform vec4 intrinsics;  // fx, fy, cx, cy of the canvas (pixels)
-uniform vec2 depthMap;    // z_ndc = depthMap.x + depthMap.y / z
-uniform vec4 lighting;    // ambient, diffuse, specular, shininess
+flat in float vInverseRadius;
+uniform vec4 pixelToRay;   // ray (x, y, 1) through window point w: x = w.x pixelToRay.x + pixelToRay.z, y likewise
+uniform vec2 windowDepth;  // window depth of camera depth z: windowDepth.x + windowDepth.y / z
+uniform vec4 lighting;     // ambient, diffuse, specular, shininess
 uniform float gain;
 out vec4 fragColour;
-// Few divisions: llvmpipe runs this for every pixel of every sphere's box.
+// Few divisions and roots (llvmpipe runs this for every pixel of every sphere's box,
+// and takes an inverse root as a root and a division): three of each, and one more root.
 void main() {
   vec3 c = vSphere.xyz;
   float r = vSphere.w;
   // The ray through this pixel's centre, p = t d (d.z = 1, so t is the depth z).
-  vec3 d = vec3((gl_FragCoord.xy - 0.5 - intrinsics.zw) / intrinsics.xy, 1.0);
-  float invLength = inversesqrt(dot(d, d));
+  vec3 d = vec3(gl_FragCoord.xy * pixelToRay.xy + pixelToRay.zw, 1.0);
+  float rootD = sqrt(dot(d, d));
   // Distance of the ray from the centre, |c x d| / |d|: no cancellation, unlike
   // |c|^2 - (c.d)^2/|d|^2, so far, small spheres keep sub-pixel edges in float.
-  float h = length(cross(c, d)) * invLength;
+  float h = length(cross(c, d)) / rootD;
   // Coverage from the signed distance to the silhouette in pixels (h - r over the
-  // screen-space gradient of h): a one-pixel ramp centred on the exact edge.
+  // screen-space gradient of h): a one-pixel ramp centred on the exact edge. (Not
+  // from h^2: its finite-difference gradient is a tenth off on a small sphere, which
+  // would widen the ramp beyond the half pixel the culler allows for.)
   vec2 gradient = vec2(dFdx(h), dFdy(h));
   float coverage = clamp(0.5 - (h - r) * inversesqrt(max(dot(gradient, gradient), 1e-30)), 0.0, 1.0);
   if (coverage <= 0.0) discard;
-  // Nearest hit (beyond the silhouette, the tangent point): t |d| = c.d/|d| - sqrt(r^2 - h^2).
+  // Nearest hit (beyond the silhouette, the tangent point): t |d| = c.d/|d| - s with
+  // s = sqrt(r^2 - h^2), so the window depth a + b/t = a + b |d|^2 / (c.d - s |d|).
   float s = sqrt(max(r * r - h * h, 0.0));
-  float t = (dot(c, d) * invLength - s) * invLength;
+  float depth = windowDepth.x + windowDepth.y * (rootD * rootD) / (dot(c, d) - s * rootD);
   // With the light at the eye, n.l = n.v = n.h = sqrt(1 - (h/r)^2) = s / r.
   // Blinn-Phong's highlight x^n (x = n.h) as (1 - n (1 - x) / 4)^4: both are
   // exp(-n (1 - x)) near the peak (same half width), without pow's exp2/log2,
   // which cost 11 % of a frame under llvmpipe.
-  float ndv = s / r;
+  float ndv = s * vInverseRadius;
   float highlight = max(1.0 - 0.25 * lighting.w * (1.0 - ndv), 0.0);
   highlight *= highlight;
   highlight *= highlight;
   vec3 lit = vColour * (lighting.x + lighting.y * ndv) + vec3(lighting.z * highlight);
-  fragColour = vec4(gain * lit, coverage);
-  gl_FragDepth = 0.5 * (depthMap.x + depthMap.y / t) + 0.5;
+  // Clamped here, as the core profile's blending clamps it for the 8-bit target (the
+  // compatibility profile clamps it once more elsewhere, a level apart now and then).
+  fragColour = vec4(min(gain * lit, vec3(1.0)), coverage);
+  gl_FragDepth = depth;
 }
 )";
 

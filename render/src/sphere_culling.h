@@ -11,6 +11,11 @@
 // it (marked depth < its smallest depth z − r). Interpenetrating spheres (clump
 // members, contact overlaps) share depth ranges, so neither hides the other here:
 // the depth buffer sorts them out.
+//
+// A sphere that stays is bounded by the pixels where it can still show: a pixel
+// centre marked by something wholly in front is covered opaquely by that nearer
+// sphere, drawn later (far to near), so shading it here changes nothing. Its
+// drawn box shrinks to the rectangle of the pixels that are left.
 #include <cstdint>
 #include <vector>
 
@@ -34,21 +39,29 @@ struct Footprint {  // pixels
   bool valid;
 };
 
+// Pixels (inclusive, canvas coordinates) where a sphere may show; empty = hidden.
+struct PixelRect {
+  std::int32_t u0, v0, u1, v1;
+  bool empty() const { return u0 > u1; }
+  bool operator==(const PixelRect&) const = default;
+};
+
 class SphereCuller {
  public:
   /// `threads` bands of rows culled at once (0: the machine's cores, at most 8); the
   /// result does not depend on it.
   explicit SphereCuller(int threads = 0);
-  /// `order` lists indices into `spheres` near to far. Returns visible[i] for each sphere.
-  const std::vector<std::uint8_t>& cull(const std::vector<CameraSphere>& spheres, const std::vector<std::uint32_t>& order,
+  /// `order` lists indices into `spheres` near to far. Returns, for each sphere, the
+  /// rectangle of pixels where it may show (empty: hidden).
+  const std::vector<PixelRect>& cull(const std::vector<CameraSphere>& spheres, const std::vector<std::uint32_t>& order,
                                         const Canvas& canvas);
 
  private:
   int threads_;
   std::vector<float> marked_;  // per canvas pixel: depth behind which everything is hidden (m), +inf unmarked
   std::vector<Footprint> footprints_;
-  std::vector<std::vector<std::uint8_t>> bandVisible_;  // per band of rows: visible there
-  std::vector<std::uint8_t> visible_;
+  std::vector<std::vector<PixelRect>> bandRects_;  // per band of rows: where each shows there
+  std::vector<PixelRect> rects_;
 };
 
 }  // namespace rocklab::render::detail

@@ -10,6 +10,10 @@ namespace rocklab::render::detail {
 
 namespace {
 
+struct Box {  // canvas pixels
+  double u0, v0, u1, v1;
+};
+
 std::uint8_t toByte(float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
 // Normalised image extent of a sphere along one axis (Mara & McGuire 2013): in the
@@ -21,6 +25,21 @@ std::pair<double, double> extent(double a, double z, double r) {
   return {(a * t - z * r) / (z * t + a * r), (a * t + z * r) / (z * t - a * r)};
 }
 
+// A point sprite is a square: the smallest one around `box` (side its longer edge),
+// shifted along the shorter edge to stay within the sphere's whole image where it can,
+// so it shades no pixel the whole image would not.
+Box pointSquare(const Box& box, const Box& image) {
+  const double side = std::max(box.u1 - box.u0, box.v1 - box.v0);
+  const auto place = [side](double lo, double hi, double imageLo, double imageHi) {
+    double a = std::max(std::min(0.5 * (lo + hi - side), imageHi - side), imageLo);
+    a = std::clamp(a, hi - side, lo);  // it must hold [lo, hi]
+    return std::pair{a, a + side};
+  };
+  const auto [u0, u1] = place(box.u0, box.u1, image.u0, image.u1);
+  const auto [v0, v1] = place(box.v0, box.v1, image.v0, image.v1);
+  return {u0, v0, u1, v1};
+}
+
 }  // namespace
 
 SpherePass::SpherePass(const GlApi& gl)
@@ -28,8 +47,8 @@ SpherePass::SpherePass(const GlApi& gl)
       program_(gl, kSphereVertexShader, kSphereFragmentShader, "sphere"),
       uCanvasSize_(program_.uniform("canvasSize")),
       uAsQuads_(program_.uniform("asQuads")),
-      uIntrinsics_(program_.uniform("intrinsics")),
-      uDepthMap_(program_.uniform("depthMap")),
+      uPixelToRay_(program_.uniform("pixelToRay")),
+      uWindowDepth_(program_.uniform("windowDepth")),
       uLighting_(program_.uniform("lighting")),
       uGain_(program_.uniform("gain")) {
   float range[2] = {1.0f, 1.0f};
@@ -121,25 +140,38 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
   }
   order_.resize(keys_.size());
   for (std::size_t k = 0; k < keys_.size(); ++k) order_[k] = keys_[k].index;
-  const std::vector<std::uint8_t>& visible = culler_.cull(staged_, order_, canvas);
+  const std::vector<PixelRect>& shows = culler_.cull(staged_, order_, canvas);
 
   instances_.clear();
   quadInstances_.clear();
   const double margin = 0.6;  // pixels: the soft edge reaches half a pixel beyond the silhouette
   for (auto k = order_.rbegin(); k != order_.rend(); ++k) {
-    if (!visible[*k]) continue;
+    const PixelRect& rect = shows[*k];
+    if (rect.empty()) continue;
     const CameraSphere& s = staged_[*k];
     const auto [x0, x1] = extent(s.x, s.z, s.radius);
     const auto [y0, y1] = extent(s.y, s.z, s.radius);
-    const double u0 = canvas.fx * x0 + canvas.cx - margin, u1 = canvas.fx * x1 + canvas.cx + margin;
-    const double v0 = canvas.fy * y0 + canvas.cy - margin, v1 = canvas.fy * y1 + canvas.cy + margin;
-    const Instance instance{{s.x, s.y, s.z, s.radius},
-                            {static_cast<float>(u0), static_cast<float>(v0), static_cast<float>(u1), static_cast<float>(v1)},
-                            {colours_[*k][0], colours_[*k][1], colours_[*k][2], colours_[*k][3]}};
-    // Points are clipped by their centre, so only boxes inside the canvas are points.
-    const bool inside = u0 >= 0 && v0 >= 0 && u1 <= canvas.width - 1 && v1 <= canvas.height - 1;
-    const bool fits = std::max(u1 - u0, v1 - v0) + 1.0 <= maxPointSize_;
-    (inside && fits ? instances_ : quadInstances_).push_back(instance);
+    const Box image{canvas.fx * x0 + canvas.cx - margin, canvas.fy * y0 + canvas.cy - margin,
+                    canvas.fx * x1 + canvas.cx + margin, canvas.fy * y1 + canvas.cy + margin};
+    // Only the pixels where it can still show (the others are covered by nearer spheres).
+    const Box box{std::max(image.u0, rect.u0 - 0.5), std::max(image.v0, rect.v0 - 0.5),
+                  std::min(image.u1, rect.u1 + 0.5), std::min(image.v1, rect.v1 + 0.5)};
+    if (box.u0 > box.u1 || box.v0 > box.v1) continue;  // what shows lies beyond its soft edge
+    const Box square = pointSquare(box, image);
+    const auto instance = [&](const Box& b) {
+      return Instance{{s.x, s.y, s.z, s.radius},
+                      {static_cast<float>(b.u0), static_cast<float>(b.v0), static_cast<float>(b.u1),
+                       static_cast<float>(b.v1)},
+                      {colours_[*k][0], colours_[*k][1], colours_[*k][2], colours_[*k][3]}};
+    };
+    // Points are clipped by their centre, so only squares inside the canvas are points.
+    const bool inside = square.u0 >= 0 && square.v0 >= 0 && square.u1 <= canvas.width - 1 &&
+                        square.v1 <= canvas.height - 1;
+    const bool fits = square.u1 - square.u0 + 1.0 <= maxPointSize_;
+    if (inside && fits)
+      instances_.push_back(instance(square));
+    else
+      quadInstances_.push_back(instance(box));
   }
   points_ = instances_.size();
   quads_ = quadInstances_.size();
@@ -154,8 +186,12 @@ void SpherePass::draw(const ViewUniforms& view, const Canvas& canvas) const {
   if (points_ + quads_ == 0) return;
   gl_.UseProgram(program_.id());
   gl_.Uniform2f(uCanvasSize_, static_cast<float>(canvas.width), static_cast<float>(canvas.height));
-  gl_.Uniform4f(uIntrinsics_, view.intrinsics[0], view.intrinsics[1], view.intrinsics[2], view.intrinsics[3]);
-  gl_.Uniform2f(uDepthMap_, view.depthMap[0], view.depthMap[1]);
+  // Window point (u + 0.5, v + 0.5) is pixel (u, v), whose ray is ((u − cx)/fx, (v − cy)/fy, 1).
+  const double fx = canvas.fx, fy = canvas.fy, cx = canvas.cx, cy = canvas.cy;
+  gl_.Uniform4f(uPixelToRay_, static_cast<float>(1.0 / fx), static_cast<float>(1.0 / fy),
+                static_cast<float>(-(cx + 0.5) / fx), static_cast<float>(-(cy + 0.5) / fy));
+  // Window depth = (z_ndc + 1) / 2 with z_ndc = depthMap.x + depthMap.y / z.
+  gl_.Uniform2f(uWindowDepth_, 0.5f * view.depthMap[0] + 0.5f, 0.5f * view.depthMap[1]);
   gl_.Uniform4f(uLighting_, view.lighting[0], view.lighting[1], view.lighting[2], view.lighting[3]);
   gl_.Uniform1f(uGain_, view.gain);
   if (points_ > 0) {

@@ -1,7 +1,8 @@
 #pragma once
 // Spheres as ray-cast impostors: cull against the canvas frustum and against each
-// other (sphere_culling.h), bound each image by its exact bounding box, draw far
-// to near (so soft edges blend over what lies behind). Spheres whose box fits are
+// other (sphere_culling.h), bound each image by its exact bounding box cut down to
+// the pixels where it can still show, draw far to near (so soft edges blend over
+// what lies behind). Spheres whose box fits are
 // point sprites (one primitive each: llvmpipe shades fewer 4×4 blocks than for two
 // triangles); the rest (at the canvas border, or wider than the largest point) are
 // instanced quads, drawn after the points.
@@ -46,7 +47,7 @@ class SpherePass {
 
   const GlApi& gl_;
   Program program_;
-  GLint uCanvasSize_, uAsQuads_, uIntrinsics_, uDepthMap_, uLighting_, uGain_;
+  GLint uCanvasSize_, uAsQuads_, uPixelToRay_, uWindowDepth_, uLighting_, uGain_;
   GLuint pointVao_ = 0, quadVao_ = 0, vbo_ = 0;
   float maxPointSize_ = 1.0f;
   struct Staging {  // one chunk of the sphere list, staged on its own thread

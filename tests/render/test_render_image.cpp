@@ -137,13 +137,20 @@ TEST_CASE("golden image of a tiny scene", "[render][golden]") {
   }
 }
 
-TEST_CASE("the compatibility fallback draws the same image as the core profile", "[render]") {
+TEST_CASE("the compatibility fallback draws the same image as the core profile, to a rounding", "[render]") {
   RenderOptions compat;
   compat.profile = GlProfile::Compatibility;
   Renderer core(smallSceneCamera(160, 120)), fallback(smallSceneCamera(160, 120), compat);
   CHECK_FALSE(fallback.coreProfile());
   std::printf("fallback GL_VERSION %s\n", fallback.glVersion().c_str());
-  CHECK(cv::norm(core.render(tinyScene()), fallback.render(tinyScene()), cv::NORM_INF) == 0);
+  // The same image up to one level at a few pixels: the two profiles compile the
+  // shaders apart (llvmpipe may fuse a multiply-add in one and not the other), which
+  // can round an antialiased edge pixel the other way.
+  const cv::Mat a = core.render(tinyScene()), b = fallback.render(tinyScene());
+  CHECK(cv::norm(a, b, cv::NORM_INF) <= 1);
+  cv::Mat differs;
+  cv::cvtColor(cv::abs(a - b) + cv::abs(b - a), differs, cv::COLOR_BGR2GRAY);
+  CHECK(cv::countNonZero(differs) <= a.total() / 1000);
 }
 
 TEST_CASE("motion blur smears a moving sphere along its velocity about the same centre", "[render]") {

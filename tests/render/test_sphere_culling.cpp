@@ -1,5 +1,5 @@
 // The CPU occlusion culler (render/src/sphere_culling.h): its verdict does not depend
-// on how many bands of rows it runs at once, and a sphere it drops is really hidden.
+// on how many bands of rows it runs at once, and a pixel it trims is really hidden.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -12,6 +12,7 @@
 
 using rocklab::render::detail::CameraSphere;
 using rocklab::render::detail::Canvas;
+using rocklab::render::detail::PixelRect;
 using rocklab::render::detail::SphereCuller;
 
 namespace {
@@ -50,37 +51,43 @@ double hit(const CameraSphere& s, const Canvas& c, double u, double v) {
 
 }  // namespace
 
-TEST_CASE("the sphere culler gives one verdict for any number of bands and drops only hidden spheres", "[render]") {
+TEST_CASE("the sphere culler gives one verdict for any number of bands and trims only hidden pixels", "[render]") {
   const std::vector<CameraSphere> spheres = pile();
   REQUIRE(spheres.size() == 3000);
   const std::vector<std::uint32_t> order = nearToFar(spheres);
   const Canvas canvas{320, 240, 400.0, 400.0, 159.5, 119.5};
   SphereCuller one(1);
-  const std::vector<std::uint8_t> reference = one.cull(spheres, order, canvas);
-  const auto dropped = std::count(reference.begin(), reference.end(), 0);
+  const std::vector<PixelRect> reference = one.cull(spheres, order, canvas);
+  const auto dropped = std::count_if(reference.begin(), reference.end(), [](const PixelRect& r) { return r.empty(); });
   CHECK(dropped > 1500);  // a deep pile: most are hidden, else the culler is not doing its job
   for (int threads : {2, 3, 7, 16}) {
     SphereCuller banded(threads);
     CHECK(banded.cull(spheres, order, canvas) == reference);
   }
-  // Each dropped sphere, at every pixel centre its image covers, lies behind a kept one.
-  int checkedPixels = 0;
+  // Every pixel centre a sphere's image covers outside its rectangle (all of them for a
+  // dropped sphere) shows a kept sphere in front of it, one whose rectangle holds it.
+  int hiddenPixels = 0, trimmedPixels = 0;
   for (std::size_t i = 0; i < spheres.size(); ++i) {
-    if (reference[i]) continue;
     const CameraSphere& s = spheres[i];
+    const PixelRect& rect = reference[i];
     const double u0 = canvas.fx * s.x / s.z + canvas.cx, v0 = canvas.fy * s.y / s.z + canvas.cy;
     const double reach = canvas.fx * s.radius / (s.z - s.radius) + 1.0;
     for (int v = static_cast<int>(std::floor(v0 - reach)); v <= static_cast<int>(std::ceil(v0 + reach)); ++v)
       for (int u = static_cast<int>(std::floor(u0 - reach)); u <= static_cast<int>(std::ceil(u0 + reach)); ++u) {
         if (u < 0 || v < 0 || u >= canvas.width || v >= canvas.height) continue;
+        if (!rect.empty() && u >= rect.u0 && u <= rect.u1 && v >= rect.v0 && v <= rect.v1) continue;
         const double mine = hit(s, canvas, u, v);
         if (!std::isfinite(mine)) continue;
         double nearest = INFINITY;
-        for (std::size_t k = 0; k < spheres.size(); ++k)
-          if (reference[k]) nearest = std::min(nearest, hit(spheres[k], canvas, u, v));
-        ++checkedPixels;
+        for (std::size_t k = 0; k < spheres.size(); ++k) {
+          const PixelRect& r = reference[k];
+          if (!r.empty() && u >= r.u0 && u <= r.u1 && v >= r.v0 && v <= r.v1)
+            nearest = std::min(nearest, hit(spheres[k], canvas, u, v));
+        }
+        ++(rect.empty() ? hiddenPixels : trimmedPixels);
         REQUIRE(nearest < mine);
       }
   }
-  CHECK(checkedPixels > 1000);
+  CHECK(hiddenPixels > 1000);
+  CHECK(trimmedPixels > 1000);  // kept spheres lose their hidden parts too
 }
