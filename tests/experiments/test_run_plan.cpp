@@ -121,6 +121,31 @@ TEST_CASE("collect reports failed and missing runs and never hides them", "[plan
   fs::remove_all(dir);
 }
 
+TEST_CASE("a planned set leaves an invalid variant out of its run list, says why and exits 2", "[plan]") {
+  const fs::path dir = fresh("invalid-plan");
+  // timestep.dt = -1 is refused by the scene: no line for it, so GNU parallel or a
+  // Slurm array never starts a run that can only fail; the valid ones are planned.
+  CHECK(cli({"sweep", "drop", "--vary", "timestep.dt=1e-6,-1,2e-6", "--plan", dir.string(), "--quiet"}) == 2);
+  const auto run_lines = lines(dir / "runs.txt");
+  REQUIRE(run_lines.size() == 2);
+  CHECK(run_lines[0].find("timestep.dt=1e-6") != std::string::npos);
+  CHECK(run_lines[1].find("timestep.dt=2e-6") != std::string::npos);
+  const auto sbatch = lines(dir / "slurm.sbatch");
+  CHECK(std::find(sbatch.begin(), sbatch.end(), "#SBATCH --array=1-2") != sbatch.end());
+  const auto log = lines(dir / "logs" / "timestep.dt=-1.log");
+  REQUIRE_FALSE(log.empty());
+  CHECK(log[0].find("timestep.dt") != std::string::npos);  // the message names the key
+  CHECK(lines(dir / "logs" / "timestep.dt=-1.exit") == std::vector<std::string>{"2"});
+  const auto readme = lines(dir / "README.md");
+  CHECK(std::any_of(readme.begin(), readme.end(),
+                    [](const std::string& l) { return l.find("`timestep.dt=-1`") != std::string::npos; }));
+  // Every variant invalid: nothing is written at all.
+  const fs::path none = fresh("all-invalid-plan");
+  CHECK(cli({"sweep", "drop", "--vary", "timestep.dt=-1,-2", "--plan", none.string(), "--quiet"}) == 2);
+  CHECK_FALSE(fs::exists(none));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("the Slurm array script on a local one-node Slurm gives the table of --jobs 2", "[plan][validation]") {
   // Starts (installing if needed) slurmctld + slurmd + munge on this machine.
   REQUIRE(shell("bash '" ROCKLAB_SOURCE_DIR "/scripts/local-slurm.sh' > /dev/null") == 0);

@@ -191,9 +191,18 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   for (const auto& [key, values] : o.vary) vary.push_back({{"key", key}, {"values", values}});
   json list = json::array();
   std::string lines;
+  std::size_t planned = 0;
+  std::vector<std::string> left_out;
   for (const PlannedRun& r : runs) {
     list.push_back({{"name", r.name}, {"values", r.values}, {"overrides", r.overrides}, {"invalid", r.invalid}});
+    if (!r.invalid.empty()) {
+      writeAtomically(dir / "logs" / (r.name + ".log"), "error: " + r.invalid + "\n");
+      writeExit(dir, r.name, kExitBadInput);
+      left_out.push_back(r.name);
+      continue;
+    }
     lines += runCommand(dir, scene_path, r) + "\n";
+    ++planned;
   }
   json plan = what;
   plan["scene"] = scene_path;
@@ -208,7 +217,7 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
      << "# One Slurm array task per line of runs.txt (each run: one process, one thread).\n"
      << "# Submit: sbatch " << (dir / "slurm.sbatch").string() << "; then: rocklab collect " << dir.string() << "\n"
      << "#SBATCH --job-name=rocklab-" << fs::path(scene_path).stem().string() << "\n"
-     << "#SBATCH --array=1-" << runs.size() << "\n"
+     << "#SBATCH --array=1-" << planned << "\n"
      << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n"
      << "#SBATCH --mem=" << o.slurm.memory << "\n"
      << "#SBATCH --time=" << o.slurm.time << "\n";
@@ -221,7 +230,13 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
 
   std::ostringstream rd;
   rd << "# " << what.value("kind", std::string("set")) << " of " << fs::path(scene_path).stem().string() << ": "
-     << runs.size() << " independent runs\n\n"
+     << planned << " independent runs\n\n";
+  if (!left_out.empty()) {
+    rd << "Left out, their settings invalid (the message is in `logs/NAME.log`; `plan.json` keeps them):";
+    for (const std::string& name : left_out) rd << " `" << name << "`";
+    rd << ".\n\n";
+  }
+  rd
      << "Each line of `runs.txt` is one run: `rocklab run` with its own `--out` folder under `runs/`, every\n"
      << "`--set` it needs (the seed included), one thread, its log and exit code under `logs/`. A line\n"
      << "whose run already completed does nothing (`--skip-complete`), so running the list again, or\n"
@@ -234,6 +249,19 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
      << "then merge the finished runs into the table, plot and recommendation:\n\n"
      << "    rocklab collect " << dir.string() << "\n";
   writeAtomically(dir / "README.md", rd.str());
+}
+
+int reportPlan(const fs::path& set_dir, const std::vector<PlannedRun>& runs, const std::string& kind,
+               std::ostream& log) {
+  int code = kExitOk;
+  for (const PlannedRun& r : runs) {
+    if (r.invalid.empty()) continue;
+    log << "  " << r.name << ": invalid, left out of the run list: " << r.invalid << "\n";
+    code = kExitBadInput;
+  }
+  log << kind << ": planned, nothing run: " << (set_dir / "runs.txt").string() << " (see "
+      << (set_dir / "README.md").string() << "); afterwards: rocklab collect " << set_dir.string() << "\n";
+  return code;
 }
 
 std::vector<Variant> inspectRuns(const fs::path& set_dir, const std::vector<PlannedRun>& runs) {

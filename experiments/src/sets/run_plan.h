@@ -35,9 +35,16 @@ std::vector<PlannedRun> planRuns(const SweepOptions& o);
 std::string runCommand(const std::filesystem::path& set_dir, const std::string& scene_path, const PlannedRun& run);
 
 /// Writes plan.json (with `what`: the command's own settings), runs.txt,
-/// slurm.sbatch and README.md into set_dir.
+/// slurm.sbatch and README.md into set_dir. An invalid run is in plan.json (with its
+/// message) but not in runs.txt or the Slurm array: its log gets the message and its
+/// exit code is 2, as when the set is run here.
 void writePlanFiles(const std::filesystem::path& set_dir, const SweepOptions& o, const std::vector<PlannedRun>& runs,
                     const nlohmann::json& what);
+
+/// After --plan: names the run list and each run left out as invalid. Returns
+/// kExitBadInput when a run was left out, else kExitOk.
+int reportPlan(const std::filesystem::path& set_dir, const std::vector<PlannedRun>& runs, const std::string& kind,
+               std::ostream& log);
 
 /// Runs every run that is not complete: in this process one after the other with
 /// o.threads threads (o.jobs == 0), or as o.jobs processes of one thread each,

@@ -356,11 +356,7 @@ int runStudy(const StudyOptions& options, std::ostream& log) {
   log << "study of " << first.run.name << ": " << o.figure << " for " << runs.size() << " variants into "
       << dir.string() << "\n";
   if (!o.description.empty()) log << "  " << o.description << "\n";
-  if (o.runs.plan_only) {
-    log << "study: planned, nothing run: " << (dir / "runs.txt").string() << " (see " << (dir / "README.md").string()
-        << "); afterwards: rocklab collect " << dir.string() << "\n";
-    return kExitOk;
-  }
+  if (o.runs.plan_only) return reportPlan(dir, runs, "study", log);
   const int code = executeRuns(dir, o.runs, runs, log);
   const int report = reportStudy(dir, o, runs, inspectRuns(dir, runs), first.run.name, log);
   return code != kExitOk ? code : report;

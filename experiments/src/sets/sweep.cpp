@@ -188,11 +188,7 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
   const std::filesystem::path dir = outDirFor(o, first, "-sweep");
   writePlanFiles(dir, o, runs, {{"kind", "sweep"}, {"metrics", metrics}});
   log << "sweep of " << first.run.name << ": " << runs.size() << " runs into " << dir.string() << "\n";
-  if (o.plan_only) {
-    log << "sweep: planned, nothing run: " << (dir / "runs.txt").string() << " (see " << (dir / "README.md").string()
-        << "); afterwards: rocklab collect " << dir.string() << "\n";
-    return kExitOk;
-  }
+  if (o.plan_only) return reportPlan(dir, runs, "sweep", log);
   const int code = executeRuns(dir, o, runs, log);
   const int report = reportSweep(dir, o, metrics, inspectRuns(dir, runs), first.run.name, log);
   return code != kExitOk ? code : report;
