@@ -58,7 +58,7 @@ class SphereCuller {
 
  private:
   int threads_;
-  std::vector<float> marked_;  // per canvas pixel: depth behind which everything is hidden (m), +inf unmarked
+  std::vector<std::int16_t> marked_;  // per canvas pixel: depth step behind which everything is hidden
   std::vector<Footprint> footprints_;
   std::vector<std::vector<PixelRect>> bandRects_;  // per band of rows: where each shows there
   std::vector<PixelRect> rects_;
