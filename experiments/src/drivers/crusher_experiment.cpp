@@ -21,16 +21,20 @@
 #include <optional>
 #include <ostream>
 #include <sstream>
+#include <unordered_map>
 
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "crusher/product_statistics.h"
+#include "rocklab/sim/bonds.h"
 
 namespace rocklab::experiments {
 
 namespace {
 
 using crusher::ProductBall;
+
+constexpr const char* kStopWall = "crusher.stop";  // §g.4's flat wall under the feed bin
 
 std::optional<geometry::ConeCrusherGeometry> chamberOf(const Scene& scene) {
   if (!scene.crusher) return std::nullopt;
@@ -50,7 +54,11 @@ class CrusherRunExperiment final : public Experiment {
         breakage_(e_.breakage, scene.run.seed),
         chamber_(chamberOf(scene)),
         entries_(chamberTop(chamber_)),
-        power_(e_.sample_interval) {}
+        power_(e_.sample_interval),
+        agglomerates_(scene.agglomerates) {
+    for (const sim::Wall& w : scene.model.walls)
+      if (w.name == kStopWall) release_time_ = w.active_until;
+  }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
     const sim::ParticleState& p = world->particles();
@@ -59,10 +67,17 @@ class CrusherRunExperiment final : public Experiment {
       if (p.clumps.size() > 0)
         throw std::runtime_error("experiment.type = \"crusher\" takes spheres only (the PBM feed); the scene has clumps");
       every_ = stepsIn(e_.sample_interval, world->dt());
-      for (std::size_t i = 0; i < p.size(); ++i) feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i], 0.0});
+      bonded_ = world->bonds().size() > 0;
+      bonds_at_start_ = bonds_intact_ = world->bonds().size();
+      if (bonded_ && e_.breakage.enabled)
+        throw std::runtime_error("experiment.breakage (the population balance) and a bonded feed exclude each other: "
+                                 "agglomerates break by their bonds (§g.7)");
+      startFeed(p);
       chamber_mass_ = massOf(feed_);
       if (e_.breakage.enabled) breakage_.start(*world);
+      if (bonded_ && e_.settle_bond_factor != 1.0) strengthenBonds(world, ctx);
     }
+    if (strengthened_ && world->time() >= release_time_) restoreBonds(world, ctx);
     if (world->particles().size() == 0) return false;  // the chamber is empty
     if (e_.breakage.enabled && breakage_.check(world, ctx)) {
       chamber_mass_ = massOf(world->particles());
@@ -72,10 +87,15 @@ class CrusherRunExperiment final : public Experiment {
     }
     if (world->stepCount() % every_ != 0) return true;
     meterPower(*world);
+    if (bonded_) {
+      const auto& intact = world->bonds().intact;
+      bonds_intact_ = static_cast<std::size_t>(std::count(intact.begin(), intact.end(), std::uint8_t{1}));
+    }
     return discharge(world, ctx);
   }
 
-  /// Removes the balls below discharge_height (product); false when none is left.
+  /// Removes the balls below discharge_height (product; a bonded feed: the
+  /// fragments whose centre of mass is below it); false when none is left.
   bool discharge(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const sim::ParticleState& p = world->particles();
     std::vector<double> heights(p.size());
@@ -83,11 +103,15 @@ class CrusherRunExperiment final : public Experiment {
     entries_.record(p.id, heights, world->time());
     std::vector<bool> remove(p.size(), false);
     bool any = false;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      if (!(p.position[i].z() < e_.discharge_height)) continue;
-      remove[i] = any = true;
-      product_.push_back(
-          {p.id[i], world->time(), 2 * p.radius[i], p.mass[i], entries_.residence(p.id[i], world->time())});
+    if (bonded_) {
+      any = dischargeFragments(*world, remove);
+    } else {
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        if (!(p.position[i].z() < e_.discharge_height)) continue;
+        remove[i] = any = true;
+        product_.push_back(
+            {p.id[i], world->time(), 2 * p.radius[i], p.mass[i], entries_.residence(p.id[i], world->time())});
+      }
     }
     if (any) {
       switchPhase(world, ctx, [](sim::Model&) {}, remove);
@@ -97,9 +121,104 @@ class CrusherRunExperiment final : public Experiment {
     return true;
   }
 
+  /// The fragments (balls joined by intact bonds) whose centre of mass is below
+  /// discharge_height: recorded as product (Eq 6-15 size) and flagged in `remove`.
+  bool dischargeFragments(const sim::World& world, std::vector<bool>& remove) {
+    const sim::ParticleState& p = world.particles();
+    const std::vector<std::uint32_t> label = sim::bondedClusters(p.size(), world.bonds());
+    const std::size_t n = label.empty() ? 0 : *std::max_element(label.begin(), label.end()) + 1;
+    std::vector<double> mass(n, 0.0), moment(n, 0.0), volume(n, 0.0);
+    std::vector<std::size_t> first(n, p.size()), balls(n, 0);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const std::uint32_t f = label[i];
+      mass[f] += p.mass[i];
+      moment[f] += p.mass[i] * p.position[i].z();
+      volume[f] += 4.0 / 3.0 * std::numbers::pi * std::pow(p.radius[i], 3);
+      first[f] = std::min(first[f], i);
+      ++balls[f];
+    }
+    std::vector<bool> out(n, false);
+    bool any = false;
+    // Centre of mass below: `out`; residence from its earliest ball's entry.
+    for (std::size_t f = 0; f < n; ++f) {
+      out[f] = moment[f] < e_.discharge_height * mass[f];
+      any = any || out[f];
+    }
+    std::vector<double> residence(n, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      if (!out[label[k]]) continue;
+      const double r = entries_.residence(p.id[k], world.time());
+      double& best = residence[label[k]];
+      if (std::isnan(best) || r > best) best = r;
+    }
+    for (std::size_t f = 0; f < n; ++f) {
+      if (!out[f]) continue;
+      const std::size_t i = first[f];
+      const double porosity = porosityOf(p.id[i]);
+      // Eq 6-15; a lone ball of no agglomerate is its own size, exactly.
+      const double diameter = balls[f] == 1 && porosity == 0.0
+                                  ? 2 * p.radius[i]
+                                  : 2 * std::cbrt(3 * volume[f] / (4 * std::numbers::pi * (1 - porosity)));
+      product_.push_back({p.id[i], world.time(), diameter, mass[f], residence[f]});
+      fragment_balls_.push_back(balls[f]);
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) remove[i] = out[label[i]];
+    return any;
+  }
+
+  /// The feed's curve: one entry per agglomerate (Eq 6-15 of the whole: its
+  /// diameter) and per ball of none.
+  void startFeed(const sim::ParticleState& p) {
+    std::vector<bool> in_agglomerate(p.size(), false);
+    for (const AgglomerateReport& a : agglomerates_) {
+      double mass = 0;
+      for (std::size_t i = a.first_ball; i < a.first_ball + a.balls && i < p.size(); ++i) {
+        mass += p.mass[i];
+        in_agglomerate[i] = true;
+        porosity_[p.id[i]] = a.porosity;
+      }
+      const double diameter = 2 * std::cbrt(3 * a.solid_volume / (4 * std::numbers::pi * (1 - a.porosity)));
+      feed_.push_back({a.balls > 0 ? p.id[a.first_ball] : 0, 0.0, diameter, mass, 0.0});
+    }
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!in_agglomerate[i]) feed_.push_back({p.id[i], 0.0, 2 * p.radius[i], p.mass[i], 0.0});
+  }
+
+  double porosityOf(std::uint64_t id) const {
+    const auto it = porosity_.find(id);
+    return it == porosity_.end() ? 0.0 : it->second;
+  }
+
+  /// The bonds' strengths times settle_bond_factor while the feed settles (§g.7 step 3).
+  void strengthenBonds(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    switchState(world, ctx, [&](sim::WorldState& s) {
+      tensile_ = s.bonds.tensile_strength;
+      shear_ = s.bonds.shear_strength;
+      for (double& v : s.bonds.tensile_strength) v *= e_.settle_bond_factor;
+      for (double& v : s.bonds.shear_strength) v *= e_.settle_bond_factor;
+    });
+    strengthened_ = true;
+  }
+
+  /// Step 4: the strengths as they were (bit for bit when no bond left meanwhile).
+  void restoreBonds(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+    switchState(world, ctx, [&](sim::WorldState& s) {
+      intact_at_release_ = static_cast<double>(std::count(s.bonds.intact.begin(), s.bonds.intact.end(), std::uint8_t{1}));
+      if (s.bonds.size() == tensile_.size()) {
+        s.bonds.tensile_strength = tensile_;
+        s.bonds.shear_strength = shear_;
+      } else {
+        for (double& v : s.bonds.tensile_strength) v /= e_.settle_bond_factor;
+        for (double& v : s.bonds.shear_strength) v /= e_.settle_bond_factor;
+      }
+    });
+    strengthened_ = false;
+    restored_at_ = world->time();
+  }
+
   std::string progress() const override {
     std::ostringstream s;
-    s << product_.size() << " balls discharged";
+    s << product_.size() << (bonded_ ? " fragments discharged" : " balls discharged");
     if (e_.breakage.enabled) s << ", " << breakage_.progress();
     return s.str();
   }
@@ -152,6 +271,28 @@ class CrusherRunExperiment final : public Experiment {
     c["power"] = power_.report();
     c["power_W"] = c["power"]["power_W"];
     c["breakages"] = breakage_.events().size();
+    if (bonded_) {
+      nlohmann::json b;
+      b["agglomerates"] = agglomerates_.size();
+      b["fragments_discharged"] = product_.size();
+      b["balls_per_fragment_max"] =
+          fragment_balls_.empty() ? 0 : *std::max_element(fragment_balls_.begin(), fragment_balls_.end());
+      b["single_balls_discharged"] = std::count(fragment_balls_.begin(), fragment_balls_.end(), std::size_t{1});
+      double porosity = 0;
+      for (const AgglomerateReport& a : agglomerates_) porosity += a.porosity / static_cast<double>(agglomerates_.size());
+      b["porosity_mean"] = porosity;
+      b["bonds"] = bonds_at_start_;
+      b["bonds_intact_at_end"] = bonds_intact_;  // at the last sample; discharged fragments' bonds are gone
+      b["bonds_intact_at_release"] = std::isnan(intact_at_release_) ? nlohmann::json(nullptr) : nlohmann::json(intact_at_release_);
+      b["settle_bond_factor"] = e_.settle_bond_factor;
+      b["strengths_restored_s"] = std::isnan(restored_at_) ? nlohmann::json(nullptr) : nlohmann::json(restored_at_);
+      b["method"] = "fragments = balls joined by intact bonds; product when the centre of mass is below "
+                    "discharge_height; diameter by Eq 6-15 with the agglomerate's porosity";
+      c["bonded"] = b;
+      c["method"] = "bonded feed: a fragment whose centre of mass is below discharge_height is product: removed, "
+                    "its Eq 6-15 diameter and mass recorded (product.csv, id = its first ball); psd = mass fraction "
+                    "of the product finer than each sieve size";
+    }
     c["whiten"] = whiten_report;
     writePowerPlot(out_dir, log);
     if (e_.breakage.enabled) {
@@ -164,8 +305,8 @@ class CrusherRunExperiment final : public Experiment {
       c["breakage"] = b;
     }
     r["crusher"] = c;
-    log << "crusher: " << product_.size() << " balls discharged (" << product_mass << " kg of " << feed_mass
-        << " kg fed)";
+    log << "crusher: " << product_.size() << (bonded_ ? " fragments" : " balls") << " discharged (" << product_mass
+        << " kg of " << feed_mass << " kg fed)";
     if (e_.breakage.enabled)
       log << ", " << breakage_.events().size() << " broke into " << breakage_.fragmentsCreated() << " fragments";
     log << "\n";
@@ -184,6 +325,16 @@ class CrusherRunExperiment final : public Experiment {
   crusher::PowerMeter power_;
   double metered_work_ = 0, metered_time_ = 0;  // J, s: the moving walls' work at the last sample
   std::size_t events_seen_ = 0;  // breakage events whose fragments inherited their entry
+  std::vector<AgglomerateReport> agglomerates_;    // the scene's, for the bonded feed
+  bool bonded_ = false;                            // the world has bonds: discharge by fragments
+  std::unordered_map<std::uint64_t, double> porosity_;  // ball id -> its agglomerate's porosity
+  std::vector<std::size_t> fragment_balls_;        // balls of each discharged fragment
+  double release_time_ = std::numeric_limits<double>::infinity();  // s, the stop wall goes
+  bool strengthened_ = false;
+  double restored_at_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> tensile_, shear_;  // the strengths before settle_bond_factor
+  std::size_t bonds_at_start_ = 0, bonds_intact_ = 0;
+  double intact_at_release_ = std::numeric_limits<double>::quiet_NaN();
 
   static double massOf(const std::vector<ProductBall>& balls) {
     double m = 0;
@@ -262,13 +413,21 @@ std::unique_ptr<Experiment> makeCrusherRunExperiment(const Scene& scene) {
   return std::make_unique<CrusherRunExperiment>(scene);
 }
 
-std::shared_ptr<ExperimentSettings> readCrusherRunSettings(TableReader& t, const SettingsContext&) {
+std::shared_ptr<ExperimentSettings> readCrusherRunSettings(TableReader& t, const SettingsContext& context) {
   auto settings = std::make_shared<CrusherRunSettings>();
   settings->discharge_height = t.number("discharge_height", settings->discharge_height);
   if (t.has("sieves_mm")) {
     settings->sieves_mm = t.numberList("sieves_mm", Range::positive());
     if (!std::is_sorted(settings->sieves_mm.begin(), settings->sieves_mm.end()) || settings->sieves_mm.empty())
       t.fail("sieves_mm", "must be a non-empty list of sizes in increasing order (mm)");
+  }
+  settings->settle_bond_factor = t.number("settle_bond_factor", 1.0, Range::closed(1.0, 1e12));
+  if (settings->settle_bond_factor != 1.0) {
+    const auto& walls = context.model.walls;
+    const auto stop = std::find_if(walls.begin(), walls.end(), [](const sim::Wall& w) { return w.name == kStopWall; });
+    if (stop == walls.end() || !std::isfinite(stop->active_until))
+      t.fail("settle_bond_factor", std::string("needs the feed bin's stop wall (a wall named ") + kStopWall +
+                                       " that goes: crusher.feed_bin = true); the bonds are strong until it goes");
   }
   readBreakageSettings(t, settings->breakage);
   settings->whiten.k1 = 1e-3 * t.number("whiten_k1_mm", 0.0, Range::nonNegative());

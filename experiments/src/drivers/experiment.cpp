@@ -53,4 +53,12 @@ void switchPhase(std::unique_ptr<sim::World>& world, const ExperimentContext& ct
   world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
 }
 
+void switchState(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx,
+                 const std::function<void(sim::WorldState&)>& edit) {
+  sim::Model model = world->model();
+  sim::WorldState state = world->exportState();
+  edit(state);
+  world = std::make_unique<sim::World>(std::move(model), std::move(state), ctx.threads);
+}
+
 }  // namespace rocklab::experiments

@@ -77,6 +77,10 @@ void switchPhase(std::unique_ptr<sim::World>& world, const ExperimentContext& ct
                  const std::function<void(sim::Model&)>& edit,
                  const std::vector<bool>& remove = {});
 
+/// Rebuilds `world` after `edit` changed a copy of its state (the model kept).
+void switchState(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx,
+                 const std::function<void(sim::WorldState&)>& edit);
+
 /// The most steps a run counts: t = step dt is exact in a double up to 2^53.
 inline constexpr double kMaxSteps = 9007199254740992.0;
 

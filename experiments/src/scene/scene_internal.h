@@ -56,6 +56,11 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
 /// set by readBonds), its report into scene.agglomerates.
 void readAgglomerate(TableReader& t, int material, const std::filesystem::path& base_dir, geometry::Rng& rng,
                      Scene& scene);
+/// [[particles]] type = "agglomerates": `count` agglomerates of diameters uniform in
+/// [diameter_min, diameter_max] at random in a box, each turned at random (§g.7's
+/// bonded feed); `placed` grows by their bounding spheres.
+void readAgglomerateFeed(TableReader& t, int material, geometry::Rng& rng, std::vector<geometry::Sphere>& placed,
+                         Scene& scene);
 /// [bonds]: the parallel-bond model and the strengths of the agglomerates' bonds
 /// (constant, or Weibull per bond or per agglomerate, seeded).
 void readBonds(TableReader& root, std::uint64_t seed, Scene& scene);

@@ -208,8 +208,15 @@ void readParticles(TableReader& root, const std::map<std::string, int>& material
   // Every ball placed so far (clump members in world position), for insertion.
   std::vector<geometry::Sphere> placed;
   for (TableReader t : root.tableArray("particles")) {
-    const std::string type = t.requiredString("type", {"lattice", "random", "list", "agglomerate"});
+    const std::string type = t.requiredString("type", {"lattice", "random", "list", "agglomerate", "agglomerates"});
     const int material = materialIndex(t, materials);
+    if (type == "agglomerates") {
+      geometry::Rng feed_rng(seed * 1000003ull + source_index);
+      readAgglomerateFeed(t, material, feed_rng, placed, scene);
+      t.finish();
+      ++source_index;
+      continue;
+    }
     if (type == "agglomerate") {
       geometry::Rng agglomerate_rng(seed * 1000003ull + source_index);
       readAgglomerate(t, material, base_dir, agglomerate_rng, scene);
