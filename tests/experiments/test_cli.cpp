@@ -131,6 +131,26 @@ TEST_CASE("check and list", "[cli]") {
   CHECK(cli({"list"}) == 0);
 }
 
+TEST_CASE("check prints the step the run takes with the bonds' springs", "[cli]") {
+  // zwick-hcp's bonds are stiffer than its contacts: check once left them out and
+  // printed a step six times the run's.
+  std::ostringstream printed;
+  auto* const old = std::cout.rdbuf(printed.rdbuf());
+  const int code = cli({"check", "zwick-hcp"});
+  std::cout.rdbuf(old);
+  REQUIRE(code == 0);
+  const std::string text = printed.str();
+  const auto at = text.find("chosen dt");
+  REQUIRE(at != std::string::npos);
+  const double printed_dt = std::stod(text.substr(text.find_first_of("0123456789", at)));
+  const fs::path out = tempDir("check-dt");
+  REQUIRE(cli({"run", "zwick-hcp", "--out", out.string(), "--quiet", "--set", "scene.end_time=1e-5"}) == 0);
+  std::ifstream in(out / "results.json");
+  const double run_dt = nlohmann::json::parse(in)["dt_s"].get<double>();
+  CHECK(printed_dt == Approx(run_dt).epsilon(1e-3));  // printed to four digits
+  fs::remove_all(out);
+}
+
 TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and results", "[cli]") {
   const fs::path out = tempDir("sigint");
   std::thread interrupter([] {

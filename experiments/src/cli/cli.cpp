@@ -489,7 +489,8 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
 
   if (command == "check") {
     try {
-      sim::World world(scene.model, scene.spheres, scene.clumps, 1);
+      // Built as a run builds it, bonds included: their springs set the step of a bonded scene.
+      sim::World world(scene.model, scene.spheres, scene.clumps, scene.bonds, 1);
       std::cout << scene.source.string() << ": valid; " << scene.spheres.size() << " spheres, "
                 << scene.clumps.size() << " clumps, " << scene.model.walls.size() << " walls\n"
                 << world.timestepAudit().describe(scene.model.timestep) << "\n";
