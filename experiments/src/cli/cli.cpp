@@ -143,7 +143,7 @@ int doSceneKeys(const std::string& check) {
 }
 
 int doList() {
-  listFiles("built-in scenes", builtinSceneDir(), [](const auto& f) { return loadScene(f).run.description; });
+  listFiles("built-in scenes", builtinSceneDir(), [](const auto& f) { return sceneDescription(f); });
   listFiles("built-in studies, rocklab study NAME", builtinStudyDir(),
             [](const auto& f) { return loadStudyFile(f).description; });
   return kExitOk;

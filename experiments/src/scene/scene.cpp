@@ -116,6 +116,16 @@ Scene loadScene(const std::filesystem::path& path, const std::vector<std::string
   return scene;
 }
 
+std::string sceneDescription(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path.string() + ": cannot open the scene file (does it exist?)");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  toml::table table = parseToml(buf.str(), path.string());
+  resolveExtends(table, path.parent_path(), 0);
+  return table["scene"]["description"].value_or(std::string());
+}
+
 std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))

@@ -149,6 +149,9 @@ struct Scene {
 /// Parses and validates a scene. `overrides` are "key.path=value" strings
 /// (from --set), applied before validation; value is TOML (1e-6, "text", [0,0,1]).
 Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
+/// [scene] description of a scene file (its `extends` followed), without building the
+/// scene: a listing need not make a bonded feed's agglomerates. Throws SceneError.
+std::string sceneDescription(const std::filesystem::path& path);
 Scene loadSceneText(const std::string& text, const std::string& source_name,
                     const std::vector<std::string>& overrides = {},
                     const std::filesystem::path& base_dir = {});
