@@ -7,8 +7,9 @@
 // When another process holds a core (a shared node, a laptop, a second run
 // beside this one), a team of two time-slices with it and waits at every
 // barrier: the 16,000-ball settle scene ran 1.2x slower on two threads than on
-// one beside a busy process, even with the short spin of app/main.cpp. So the tuner measures: a window on the current team, then a window on the
-// other, and keeps the faster. A probe that confirms the current team doubles
+// one beside a busy process, even with the short spin of app/main.cpp. So the
+// tuner measures: a window on the current team, then a window on the other, and
+// keeps the faster. A probe that confirms the current team doubles
 // the time to the next probe (up to kMaxInterval), so a quiet machine pays a
 // probe window about every half minute; a switch goes back to probing often.
 #include <algorithm>

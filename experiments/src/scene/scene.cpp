@@ -102,39 +102,40 @@ Scene loadSceneText(const std::string& text, const std::string& source_name,
   return scene;
 }
 
-Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+namespace {
+
+/// The text of a `kind` file ("scene", "camera"); `hint` says what to give instead of a folder.
+std::string readTomlFile(const std::filesystem::path& path, const std::string& kind, const std::string& hint) {
   std::error_code ec;
   // A folder opens as an empty file on Linux: the reader would say "missing [scene]".
   if (std::filesystem::is_directory(path, ec))
-    throw SceneError(path.string() + ": is a directory, not a scene file (give a .toml file or a built-in name)");
+    throw SceneError(path.string() + ": is a directory, not a " + kind + " file (" + hint + ")");
   std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open the scene file (does it exist?)");
+  if (!in) throw SceneError(path.string() + ": cannot open the " + kind + " file (does it exist?)");
   std::stringstream buf;
   buf << in.rdbuf();
-  Scene scene = loadSceneText(buf.str(), path.string(), overrides, path.parent_path());
+  return buf.str();
+}
+
+const char* const kSceneFileHint = "give a .toml file or a built-in name";
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  Scene scene = loadSceneText(readTomlFile(path, "scene", kSceneFileHint), path.string(), overrides, path.parent_path());
   scene.source = path;
   return scene;
 }
 
 std::string sceneDescription(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open the scene file (does it exist?)");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  toml::table table = parseToml(buf.str(), path.string());
+  toml::table table = parseToml(readTomlFile(path, "scene", kSceneFileHint), path.string());
   resolveExtends(table, path.parent_path(), 0);
   return table["scene"]["description"].value_or(std::string());
 }
 
 std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw SceneError(path.string() + ": is a directory, not a camera file (give a .toml file with [[cameras]])");
-  std::ifstream in(path);
-  if (!in) throw SceneError(path.string() + ": cannot open the camera file (does it exist?)");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  const toml::table table = parseToml(buf.str(), path.string());
+  const toml::table table =
+      parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
   TableReader root(table, "");
   std::vector<CameraSettings> cameras;
   detail::readCameras(root, cameras);

@@ -71,9 +71,8 @@ Body makeHcp(TableReader& t, double radius, double diameter, double angle, doubl
   return body;
 }
 
-/// The spheres (agglomerate frame) and bonded pairs of an HCP source.
-void readHcp(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sphere>& body,
-             std::vector<geometry::SpherePair>& pairs) {
+/// An HCP source (agglomerate frame).
+Body readHcp(TableReader& t) {
   const double radius = t.requiredNumber("radius", Range::positive());
   const double diameter = t.requiredNumber("diameter", Range::positive());
   if (diameter < 2 * radius) t.fail("diameter", "must be at least two sphere radii");
@@ -81,17 +80,12 @@ void readHcp(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sp
   // between the stacking axis and y, which the platens of a test along y see.
   const double angle = t.number("hcp_angle", 0.0, Range::closed(0, 90));
   const double gap_tolerance = t.number("gap_tolerance", 1e-3, Range::closed(0, 0.5));
-  Body made = makeHcp(t, radius, diameter, angle, gap_tolerance, "diameter");
-  body = std::move(made.spheres);
-  pairs = std::move(made.pairs);
-  report.diameter = made.diameter;
-  report.porosity = made.porosity;
-  report.coordination_number = made.coordination_number;
+  return makeHcp(t, radius, diameter, angle, gap_tolerance, "diameter");
 }
 
-/// The same from agglomerate `index` of a library file (its own bonds).
-void readLibrary(TableReader& t, const std::filesystem::path& base_dir, AgglomerateReport& report,
-                 std::vector<geometry::Sphere>& body, std::vector<geometry::SpherePair>& pairs) {
+/// Agglomerate `index` of a library file (its own bonds); `method` becomes
+/// "library:<its method>".
+Body readLibrary(TableReader& t, const std::filesystem::path& base_dir, std::string& method) {
   const std::filesystem::path file = base_dir / t.requiredString("library");
   std::vector<AgglomerateRecord> library;
   try {
@@ -104,12 +98,14 @@ void readLibrary(TableReader& t, const std::filesystem::path& base_dir, Agglomer
     t.fail("index", "the library " + file.string() + " holds " + std::to_string(library.size()) +
                         " agglomerates (indices 0.." + std::to_string(library.size() - 1) + ")");
   const AgglomerateRecord& a = library[static_cast<std::size_t>(index)];
-  body = a.spheres;
-  for (const auto& b : a.bonds) pairs.emplace_back(b[0], b[1]);
-  report.method = "library:" + a.method;
-  report.diameter = a.diameter;
-  report.porosity = a.porosity;
-  report.coordination_number = a.coordination_number;
+  Body body;
+  body.spheres = a.spheres;
+  for (const auto& b : a.bonds) body.pairs.emplace_back(b[0], b[1]);
+  body.diameter = a.diameter;
+  body.porosity = a.porosity;
+  body.coordination_number = a.coordination_number;
+  method = "library:" + a.method;
+  return body;
 }
 
 /// A dense random packing (§f.4) of `spec`, made once per process: a sweep or study
@@ -165,16 +161,10 @@ agglomerate::AgglomerateSpec denseSpec(TableReader& t, double r_max, double diam
 /// of r_max spheres filling the diameter, its voids filled down to r_max / r0.
 /// Its own seed (not the scene's), so a study can turn one agglomerate through
 /// random orientations (scene.seed) or draw new ones (seed).
-void readDense(TableReader& t, AgglomerateReport& report, std::vector<geometry::Sphere>& body,
-               std::vector<geometry::SpherePair>& pairs) {
+Body readDense(TableReader& t) {
   const double r_max = t.requiredNumber("radius", Range::positive());
   const double diameter = t.requiredNumber("diameter", Range::positive());
-  Body made = makeDense(t, denseSpec(t, r_max, diameter, "diameter"), "diameter");
-  body = std::move(made.spheres);
-  pairs = std::move(made.pairs);
-  report.diameter = made.diameter;
-  report.porosity = made.porosity;
-  report.coordination_number = made.coordination_number;
+  return makeDense(t, denseSpec(t, r_max, diameter, "diameter"), "diameter");
 }
 
 /// Appends `body` turned by q, scaled by `scale` and centred at `centre` as spheres
@@ -213,16 +203,9 @@ void readAgglomerate(TableReader& t, int material, const std::filesystem::path& 
   AgglomerateReport report;
   report.source = t.path();
   report.method = t.string("method", "hcp", {"hcp", "dense", "library"});
-  Body body;
-  if (report.method == "hcp")
-    readHcp(t, report, body.spheres, body.pairs);
-  else if (report.method == "dense")
-    readDense(t, report, body.spheres, body.pairs);
-  else
-    readLibrary(t, base_dir, report, body.spheres, body.pairs);
-  body.diameter = report.diameter;
-  body.porosity = report.porosity;
-  body.coordination_number = report.coordination_number;
+  const Body body = report.method == "hcp"     ? readHcp(t)
+                    : report.method == "dense" ? readDense(t)
+                                               : readLibrary(t, base_dir, report.method);
   // The agglomerate's frame -> world: a fixed rotation (deg about x, y, z),
   // followed by a random one (seeded) when orientation = "random", then the centre.
   geometry::Quat q = rotationFromDegrees(t.vec3("rotation", Vec3::Zero()));

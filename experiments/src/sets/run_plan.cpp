@@ -99,6 +99,12 @@ void writeExit(const fs::path& set_dir, const std::string& name, int code) {
   writeAtomically(set_dir / "logs" / (name + ".exit"), std::to_string(code) + "\n");
 }
 
+/// An invalid run, not started: its log holds the message, its exit code is 2.
+void recordInvalid(const fs::path& set_dir, const PlannedRun& run) {
+  writeAtomically(set_dir / "logs" / (run.name + ".log"), "error: " + run.invalid + "\n");
+  writeExit(set_dir, run.name, kExitBadInput);
+}
+
 /// One run started as a child process in a process group of its own, its stdout and
 /// stderr into `log`; its pid, or -1 when it could not be started.
 pid_t spawnRun(const std::vector<std::string>& args, const fs::path& log) {
@@ -196,8 +202,7 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   for (const PlannedRun& r : runs) {
     list.push_back({{"name", r.name}, {"values", r.values}, {"overrides", r.overrides}, {"invalid", r.invalid}});
     if (!r.invalid.empty()) {
-      writeAtomically(dir / "logs" / (r.name + ".log"), "error: " + r.invalid + "\n");
-      writeExit(dir, r.name, kExitBadInput);
+      recordInvalid(dir, r);
       left_out.push_back(r.name);
       continue;
     }
@@ -303,8 +308,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
     if (runCompleted(set_dir / "runs" / r.name)) {
       ++skipped;
     } else if (!r.invalid.empty()) {
-      writeAtomically(set_dir / "logs" / (r.name + ".log"), "error: " + r.invalid + "\n");
-      writeExit(set_dir, r.name, kExitBadInput);
+      recordInvalid(set_dir, r);
       log << "  " << r.name << ": invalid, not run: " << r.invalid << "\n";
     } else {
       todo.push_back(&r);
