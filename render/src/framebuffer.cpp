@@ -5,14 +5,18 @@
 
 namespace rocklab::render::detail {
 
-Framebuffer::Framebuffer(const GlApi& gl, int width, int height, int samples)
-    : gl_(gl), width_(width), height_(height), samples_(samples > 1 ? samples : 0) {
+Framebuffer::Framebuffer(const GlApi& gl, int width, int height, int samples, GLenum colourFormat)
+    : gl_(gl),
+      width_(width),
+      height_(height),
+      samples_(samples > 1 ? samples : 0),
+      floatColour_(colourFormat == GL_RGBA32F) {
   gl.GenFramebuffers(1, &fbo_);
   gl.GenRenderbuffers(1, &colour_);
   gl.GenRenderbuffers(1, &depth_);
   gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
   gl.BindRenderbuffer(GL_RENDERBUFFER, colour_);
-  gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_RGBA8, width, height);
+  gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, colourFormat, width, height);
   gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
   gl.BindRenderbuffer(GL_RENDERBUFFER, depth_);
   gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH_COMPONENT32F, width, height);
@@ -45,12 +49,19 @@ void Framebuffer::blitTo(const Framebuffer& target) const {
   gl_.check("blitting a framebuffer");
 }
 
-void Framebuffer::read(cv::Mat& bgra) const {
+void Framebuffer::blitDepthTo(const Framebuffer& target) const {
+  gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+  gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, target.fbo_);
+  gl_.BlitFramebuffer(0, 0, width_, height_, 0, 0, target.width_, target.height_, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  gl_.check("blitting a depth buffer");
+}
+
+void Framebuffer::read(cv::Mat& rgba) const {
   gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
   gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  bgra.create(height_, width_, CV_8UC4);
+  rgba.create(height_, width_, floatColour_ ? CV_32FC4 : CV_8UC4);
   gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
-  gl_.ReadPixels(0, 0, width_, height_, GL_BGRA, GL_UNSIGNED_BYTE, bgra.data);
+  gl_.ReadPixels(0, 0, width_, height_, GL_RGBA, floatColour_ ? GL_FLOAT : GL_UNSIGNED_BYTE, rgba.data);
   gl_.check("reading the frame");
 }
 

@@ -10,6 +10,7 @@
 #include "gl_api.h"
 #include "gl_context.h"
 #include "lens.h"
+#include "screen_layer.h"
 #include "sensor.h"
 #include "sphere_pass.h"
 #include "surface_pass.h"
@@ -34,10 +35,13 @@ struct Renderer::Impl {
   // Targets, all canvas-sized: `opaque` holds the background and the opaque walls
   // (drawn through `multisampled` when MSAA is on) and is redrawn only when they
   // change; each frame starts from a copy of it in `target`.
+  // `screens` holds the transparent walls when every sphere lies beyond them.
   std::unique_ptr<Framebuffer> target, opaque, multisampled;
+  std::unique_ptr<ScreenLayer> screens;
   std::vector<double> opaqueKey;  // what `opaque` shows; empty = nothing yet
   int samples = 0;                // MSAA samples used: options.msaaSamples, at most GL_MAX_SAMPLES
-  cv::Mat bgra, sum, canvasBgr;   // scratch, reused between frames
+  cv::Mat rgba, sum, canvasBgr;   // scratch, reused between frames
+  bool laidOver = false;          // the last frame's transparent walls went through `screens`
 
   Impl(const geometry::Camera& cam, const RenderOptions& opts)
       : camera(cam), options(opts), context(opts.profile == GlProfile::Compatibility) {
@@ -65,6 +69,7 @@ struct Renderer::Impl {
     target.reset();
     opaque.reset();
     multisampled.reset();
+    screens.reset();
     surfaces.reset();
     spheres.reset();
   }
@@ -81,6 +86,7 @@ struct Renderer::Impl {
     target.reset();
     opaque.reset();
     multisampled.reset();
+    screens.reset();
     target = std::make_unique<Framebuffer>(gl, w, h, 0);
     opaque = std::make_unique<Framebuffer>(gl, w, h, 0);
     if (samples > 1) multisampled = std::make_unique<Framebuffer>(gl, w, h, samples);
@@ -108,10 +114,12 @@ struct Renderer::Impl {
     opaqueKey = std::move(key);
   }
 
-  // One undistorted canvas image (BGRA) with the spheres moved by velocity × dt.
+  // One undistorted canvas image (RGBA) with the spheres moved by velocity × dt.
   void drawCanvas(const FrameDescription& frame, const ViewUniforms& view, double dt) {
     spheres->upload(frame.spheres, camera.rotation, camera.translation, lens.canvas, options.nearClip, options.farClip, dt,
-                    frame.cut);
+                    frame.cut, surfaces->screens());
+    const bool screensOnCpu = !surfaces->screens().empty() && spheres->behindScreens();
+    laidOver = laidOver && screensOnCpu;
     // 1. opaque walls: a copy of the cached layer (colour and depth)
     opaque->blitTo(*target);
     target->bindForDrawing();
@@ -122,11 +130,21 @@ struct Renderer::Impl {
     gl.Enable(GL_BLEND);
     gl.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     spheres->draw(view, lens.canvas);
-    // 3. transparent walls (Perspex), far to near, depth tested but not written
-    gl.DepthMask(GL_FALSE);
-    surfaces->drawTransparent(view);
-    gl.DepthMask(GL_TRUE);
-    target->read(bgra);
+    // 3. transparent walls (Perspex), far to near, depth tested but not written; or,
+    // when every sphere lies beyond them, their layer laid over the image.
+    if (!screensOnCpu) {
+      gl.DepthMask(GL_FALSE);
+      surfaces->drawTransparent(view);
+      gl.DepthMask(GL_TRUE);
+    }
+    target->read(rgba);
+    if (screensOnCpu) {
+      if (!screens) screens = std::make_unique<ScreenLayer>(gl, lens.canvas.width, lens.canvas.height);
+      std::vector<double> key = opaqueKey;
+      key.insert(key.end(), surfaces->transparentSignature().begin(), surfaces->transparentSignature().end());
+      screens->update(key, *opaque, *surfaces, view);
+      screens->composite(rgba);
+    }
   }
 
   cv::Mat render(const FrameDescription& frame) {
@@ -144,6 +162,7 @@ struct Renderer::Impl {
     }
     surfaces->prepare(frame, camera.rotation, camera.translation);
     updateOpaqueLayer(frame, view);
+    laidOver = true;  // until a subframe blends its transparent walls in GL
 
     // Exposure: subframes at the middles of n equal slices of the open shutter,
     // centred on frame.time, averaged (motion blur).
@@ -154,16 +173,16 @@ struct Renderer::Impl {
       sum = cv::Mat::zeros(lens.canvas.height, lens.canvas.width, CV_32FC4);
       for (int s = 0; s < n; ++s) {
         drawCanvas(frame, view, camera.exposureTime * ((s + 0.5) / n - 0.5));
-        cv::add(sum, bgra, sum, cv::noArray(), CV_32F);
+        cv::add(sum, rgba, sum, cv::noArray(), CV_32F);
       }
-      sum.convertTo(bgra, CV_8U, 1.0 / n);
+      sum.convertTo(rgba, CV_8U, 1.0 / n);
     }
     cv::Mat image;  // a new buffer every frame: the caller keeps it
     if (lens.active) {
-      cv::cvtColor(bgra, canvasBgr, cv::COLOR_BGRA2BGR);
+      cv::cvtColor(rgba, canvasBgr, cv::COLOR_RGBA2BGR);
       applyLensWarp(lens, canvasBgr, image);
     } else {
-      cv::cvtColor(bgra, image, cv::COLOR_BGRA2BGR);
+      cv::cvtColor(rgba, image, cv::COLOR_RGBA2BGR);
     }
 
     if (options.noiseSigma > 0.0) addSensorNoise(image, options.noiseSigma, options.noiseSeed, frame.index);
@@ -194,5 +213,6 @@ const RenderOptions& Renderer::options() const { return impl_->options; }
 std::string Renderer::glVersion() const { return impl_->version; }
 std::string Renderer::glRenderer() const { return impl_->rendererName; }
 bool Renderer::coreProfile() const { return impl_->context.coreProfile(); }
+bool Renderer::transparentWallsLaidOver() const { return impl_->laidOver; }
 
 }  // namespace rocklab::render

@@ -116,7 +116,9 @@ void main() {
   highlight *= highlight;
   highlight *= highlight;
   vec3 lit = colour.rgb * (lighting.x + lighting.y * ndv) + vec3(lighting.z * highlight);
-  fragColour = vec4(gain * lit, colour.a);
+  // Clamped as an 8-bit target's blending clamps it, so a float target (the screen
+  // layer, screen_layer.h) gets the same.
+  fragColour = vec4(min(gain * lit, vec3(1.0)), colour.a);
 }
 )";
 

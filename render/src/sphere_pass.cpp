@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <tuple>
 
 #include "bands.h"
 
@@ -25,18 +26,38 @@ std::pair<double, double> extent(double a, double z, double r) {
   return {(a * t - z * r) / (z * t + a * r), (a * t + z * r) / (z * t - a * r)};
 }
 
-// A point sprite is a square: the smallest one around `box` (side its longer edge),
-// shifted along the shorter edge to stay within the sphere's whole image where it can,
-// so it shades no pixel the whole image would not.
-Box pointSquare(const Box& box, const Box& image) {
-  const double side = std::max(box.u1 - box.u0, box.v1 - box.v0);
-  const auto place = [side](double lo, double hi, double imageLo, double imageHi) {
-    double a = std::max(std::min(0.5 * (lo + hi - side), imageHi - side), imageLo);
-    a = std::clamp(a, hi - side, lo);  // it must hold [lo, hi]
-    return std::pair{a, a + side};
+// llvmpipe shades a primitive in blocks of 4 × 4 pixels (aligned to the canvas, whose
+// sides are multiples of 4), a partly covered block at the cost of a whole one.
+constexpr int kShadingBlock = 4;
+
+// A point sprite is a square: the fewest pixels n on a side that hold `box` (the
+// pixel centres within it), placed where it touches the fewest shading blocks, then
+// where it reaches least beyond the sphere's whole image (its pixels there shade to
+// nothing), and within the canvas where it can (points are clipped by their centre).
+// Its edges lie halfway between pixel centres, so which pixels it holds is exact.
+Box pointSquare(const Box& box, const Box& image, int canvasWidth, int canvasHeight) {
+  const auto first = [](double edge) { return static_cast<int>(std::ceil(edge)); };
+  const auto last = [](double edge) { return static_cast<int>(std::floor(edge)); };
+  const int n = std::max(last(box.u1) - first(box.u0), last(box.v1) - first(box.v0)) + 1;
+  const auto blockOf = [](int pixel) {  // floor(pixel / 4)
+    return (pixel >= 0 ? pixel : pixel - kShadingBlock + 1) / kShadingBlock;
   };
-  const auto [u0, u1] = place(box.u0, box.u1, image.u0, image.u1);
-  const auto [v0, v1] = place(box.v0, box.v1, image.v0, image.v1);
+  // Pixels a … a + n − 1 along one axis, holding lo … hi.
+  const auto place = [&](double lo, double hi, double imageLo, double imageHi, int size) {
+    const int i0 = first(imageLo), i1 = last(imageHi);
+    const auto cost = [&](int a) {
+      const bool outsideCanvas = a - 0.5 < 0.0 || a + n - 0.5 > size - 1.0;  // as `inside` in upload()
+      const int beyondImage = std::max(0, i0 - a) + std::max(0, a + n - 1 - i1);
+      return std::tuple{outsideCanvas, blockOf(a + n - 1) - blockOf(a), beyondImage};
+    };
+    int best = last(hi) - n + 1;
+    auto bestCost = cost(best);
+    for (int a = best + 1; a <= first(lo); ++a)
+      if (const auto c = cost(a); c < bestCost) best = a, bestCost = c;
+    return std::pair{best - 0.5, best + n - 0.5};
+  };
+  const auto [u0, u1] = place(box.u0, box.u1, image.u0, image.u1, canvasWidth);
+  const auto [v0, v1] = place(box.v0, box.v1, image.v0, image.v1, canvasHeight);
   return {u0, v0, u1, v1};
 }
 
@@ -87,7 +108,7 @@ void SpherePass::setAttributes(GLuint vao, std::size_t firstInstance, GLuint div
 
 void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geometry::Mat3& rotation,
                         const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip,
-                        double dt, const std::optional<CutPlane>& cut) {
+                        double dt, const std::optional<CutPlane>& cut, const std::vector<Screen>& screens) {
   // Side planes of the canvas frustum (through the eye, two pixels outside the
   // canvas edges), inward unit normals: a sphere with n·c < −r is invisible.
   const double xl = (-2.5 - canvas.cx) / canvas.fx, xr = (canvas.width + 1.5 - canvas.cx) / canvas.fx;
@@ -108,6 +129,7 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
     out.keys.clear();
     out.staged.clear();
     out.colours.clear();
+    out.behindScreens = true;
     for (std::size_t i = n * b / chunks; i < n * (b + 1) / chunks; ++i) {
       const SphereInstance& s = spheres[i];
       const geometry::Vec3 centre = s.centre + dt * s.velocity;
@@ -120,6 +142,8 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
       bool outside = false;
       for (const auto& plane : planes) outside = outside || plane.dot(c) < -r;
       if (outside) continue;
+      for (const Screen& screen : screens)
+        out.behindScreens = out.behindScreens && screen.normal.dot(c) + screen.offset >= (1.0 - kScreenOverlap) * r;
       out.keys.push_back({c.squaredNorm() - r * r, static_cast<std::uint32_t>(out.staged.size())});
       out.staged.push_back({static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
                             static_cast<float>(r)});
@@ -130,7 +154,9 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
   keys_.clear();
   staged_.clear();
   colours_.clear();
+  behindScreens_ = true;
   for (const Staging& chunk : chunks_) {
+    behindScreens_ = behindScreens_ && chunk.behindScreens;
     const auto offset = static_cast<std::uint32_t>(staged_.size());
     const auto sorted = static_cast<std::ptrdiff_t>(keys_.size());  // the keys so far, in order
     for (const Key& k : chunk.keys) keys_.push_back({k.power, k.index + offset});
@@ -142,40 +168,49 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
   for (std::size_t k = 0; k < keys_.size(); ++k) order_[k] = keys_[k].index;
   const std::vector<PixelRect>& shows = culler_.cull(staged_, order_, canvas);
 
-  instances_.clear();
-  quadInstances_.clear();
+  // Far to near, in chunks of that order on their own threads, joined in order.
   const double margin = 0.6;  // pixels: the soft edge reaches half a pixel beyond the silhouette
-  for (auto k = order_.rbegin(); k != order_.rend(); ++k) {
-    const PixelRect& rect = shows[*k];
-    if (rect.empty()) continue;
-    const CameraSphere& s = staged_[*k];
-    const auto [x0, x1] = extent(s.x, s.z, s.radius);
-    const auto [y0, y1] = extent(s.y, s.z, s.radius);
-    const Box image{canvas.fx * x0 + canvas.cx - margin, canvas.fy * y0 + canvas.cy - margin,
-                    canvas.fx * x1 + canvas.cx + margin, canvas.fy * y1 + canvas.cy + margin};
-    // Only the pixels where it can still show (the others are covered by nearer spheres).
-    const Box box{std::max(image.u0, rect.u0 - 0.5), std::max(image.v0, rect.v0 - 0.5),
-                  std::min(image.u1, rect.u1 + 0.5), std::min(image.v1, rect.v1 + 0.5)};
-    if (box.u0 > box.u1 || box.v0 > box.v1) continue;  // what shows lies beyond its soft edge
-    const Box square = pointSquare(box, image);
-    const auto instance = [&](const Box& b) {
-      return Instance{{s.x, s.y, s.z, s.radius},
-                      {static_cast<float>(b.u0), static_cast<float>(b.v0), static_cast<float>(b.u1),
-                       static_cast<float>(b.v1)},
-                      {colours_[*k][0], colours_[*k][1], colours_[*k][2], colours_[*k][3]}};
-    };
-    // Points are clipped by their centre, so only squares inside the canvas are points.
-    const bool inside = square.u0 >= 0 && square.v0 >= 0 && square.u1 <= canvas.width - 1 &&
-                        square.v1 <= canvas.height - 1;
-    const bool fits = square.u1 - square.u0 + 1.0 <= maxPointSize_;
-    if (inside && fits)
-      instances_.push_back(instance(square));
-    else
-      quadInstances_.push_back(instance(box));
-  }
+  const std::size_t kept = order_.size();
+  runBands(chunks, [&](int b) {
+    Staging& out = chunks_[static_cast<std::size_t>(b)];
+    out.points.clear();
+    out.quads.clear();
+    for (std::size_t m = kept * b / chunks; m < kept * (b + 1) / chunks; ++m) {
+      const std::uint32_t k = order_[kept - 1 - m];
+      const PixelRect& rect = shows[k];
+      if (rect.empty()) continue;
+      const CameraSphere& s = staged_[k];
+      const auto [x0, x1] = extent(s.x, s.z, s.radius);
+      const auto [y0, y1] = extent(s.y, s.z, s.radius);
+      const Box image{canvas.fx * x0 + canvas.cx - margin, canvas.fy * y0 + canvas.cy - margin,
+                      canvas.fx * x1 + canvas.cx + margin, canvas.fy * y1 + canvas.cy + margin};
+      // Only the pixels where it can still show (the others are covered by nearer spheres).
+      const Box box{std::max(image.u0, rect.u0 - 0.5), std::max(image.v0, rect.v0 - 0.5),
+                    std::min(image.u1, rect.u1 + 0.5), std::min(image.v1, rect.v1 + 0.5)};
+      // No pixel centre inside: what shows lies beyond its soft edge.
+      if (std::ceil(box.u0) > std::floor(box.u1) || std::ceil(box.v0) > std::floor(box.v1)) continue;
+      const Box square = pointSquare(box, image, canvas.width, canvas.height);
+      const auto instance = [&](const Box& q) {
+        return Instance{{s.x, s.y, s.z, s.radius},
+                        {static_cast<float>(q.u0), static_cast<float>(q.v0), static_cast<float>(q.u1),
+                         static_cast<float>(q.v1)},
+                        {colours_[k][0], colours_[k][1], colours_[k][2], colours_[k][3]}};
+      };
+      // Points are clipped by their centre, so only squares inside the canvas are points.
+      const bool inside = square.u0 >= 0 && square.v0 >= 0 && square.u1 <= canvas.width - 1 &&
+                          square.v1 <= canvas.height - 1;
+      const bool fits = square.u1 - square.u0 + 1.0 <= maxPointSize_;
+      if (inside && fits)
+        out.points.push_back(instance(square));
+      else
+        out.quads.push_back(instance(box));
+    }
+  });
+  instances_.clear();
+  for (const Staging& chunk : chunks_) instances_.insert(instances_.end(), chunk.points.begin(), chunk.points.end());
   points_ = instances_.size();
-  quads_ = quadInstances_.size();
-  instances_.insert(instances_.end(), quadInstances_.begin(), quadInstances_.end());
+  for (const Staging& chunk : chunks_) instances_.insert(instances_.end(), chunk.quads.begin(), chunk.quads.end());
+  quads_ = instances_.size() - points_;
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(instances_.size() * sizeof(Instance)), instances_.data(),
                  GL_STREAM_DRAW);

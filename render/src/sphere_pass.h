@@ -14,6 +14,7 @@
 #include "rocklab/render/frame.h"
 #include "shaders.h"
 #include "sphere_culling.h"
+#include "surface_pass.h"
 #include "view.h"
 
 namespace rocklab::render::detail {
@@ -27,10 +28,15 @@ class SpherePass {
 
   /// Moves each centre by velocity × dt (motion-blur subframes; dt = 0 otherwise),
   /// drops the spheres whose (moved) centre lies beyond the cut, transforms to the
-  /// camera frame (double), culls, sorts, uploads.
+  /// camera frame (double), culls, sorts, uploads; and finds out whether every sphere
+  /// in view lies beyond each of `screens` (behindScreens()).
   void upload(const std::vector<SphereInstance>& spheres, const geometry::Mat3& rotation,
               const geometry::Vec3& translation, const Canvas& canvas, double nearClip, double farClip, double dt,
-              const std::optional<CutPlane>& cut = std::nullopt);
+              const std::optional<CutPlane>& cut = std::nullopt, const std::vector<Screen>& screens = {});
+  /// After upload(): every sphere in view lies beyond every screen, up to a contact
+  /// overlap (it reaches at most kScreenOverlap of its radius through the plane).
+  bool behindScreens() const { return behindScreens_; }
+  static constexpr double kScreenOverlap = 0.1;
   void draw(const ViewUniforms& view, const Canvas& canvas) const;
 
  private:
@@ -54,15 +60,18 @@ class SpherePass {
     std::vector<Key> keys;
     std::vector<CameraSphere> staged;
     std::vector<std::array<std::uint8_t, 4>> colours;
+    bool behindScreens = true;
+    std::vector<Instance> points, quads;  // this chunk of the far-to-near order
   };
   std::vector<Staging> chunks_;
   std::vector<Key> keys_;
   std::vector<CameraSphere> staged_;
   std::vector<std::array<std::uint8_t, 4>> colours_;
   std::vector<std::uint32_t> order_;
-  std::vector<Instance> instances_, quadInstances_;
+  std::vector<Instance> instances_;
   SphereCuller culler_;
   std::size_t points_ = 0, quads_ = 0;
+  bool behindScreens_ = true;
 };
 
 }  // namespace rocklab::render::detail

@@ -1,6 +1,7 @@
 #include "surface_pass.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -97,11 +98,18 @@ void SurfacePass::prepare(const FrameDescription& frame, const Mat3& rotation, c
   opaque_.clear();
   transparent_.clear();
   signature_.clear();
-  auto sign = [&](std::initializer_list<double> values) { signature_.insert(signature_.end(), values); };
+  transparentSignature_.clear();
+  screens_.clear();
+  bool flatScreens = true;
+  // Signatures: the opaque draws' and the transparent draws' values, apart.
+  bool opaqueDraw = true;
+  auto sign = [&](std::initializer_list<double> values) {
+    auto& to = opaqueDraw ? signature_ : transparentSignature_;
+    to.insert(to.end(), values);
+  };
   auto listDraw = [&](const Draw& d) {
-    const bool opaque = d.colour[3] >= 1.0f;
-    (opaque ? opaque_ : transparent_).push_back(d);
-    if (opaque) sign({d.colour[0], d.colour[1], d.colour[2]});
+    (opaqueDraw ? opaque_ : transparent_).push_back(d);
+    sign({d.colour[0], d.colour[1], d.colour[2], d.colour[3]});
   };
 
   // Polygons: fan-triangulated in the camera frame (double, then float).
@@ -120,8 +128,17 @@ void SurfacePass::prepare(const FrameDescription& frame, const Mat3& rotation, c
     for (std::size_t k = 1; k + 1 < cam.size(); ++k)
       for (const Vec3* v : {&cam[0], &cam[k], &cam[k + 1]}) pushVertex(polygonVertices_, *v, n);
     const GLsizei count = static_cast<GLsizei>(polygonVertices_.size() / 6) - first;
-    if (p.opacity >= 1.0f)
-      for (const Vec3& v : cam) sign({v.x(), v.y(), v.z()});
+    opaqueDraw = p.opacity >= 1.0f;
+    for (const Vec3& v : cam) sign({v.x(), v.y(), v.z()});
+    if (!opaqueDraw) {
+      // Its plane through the centroid, turned away from the eye (the origin). An eye
+      // within a micrometre of the plane sees the wall edge-on: no screen then.
+      const double offset = -n.dot(centroid);
+      if (std::abs(offset) > 1e-6 && n.norm() > 0.0)
+        screens_.push_back(offset < 0.0 ? Screen{n, offset} : Screen{-n, -offset});
+      else
+        flatScreens = false;
+    }
     listDraw({polygonVao_, first, count, Eigen::Matrix4f::Identity(), {p.colour.r, p.colour.g, p.colour.b, p.opacity},
               centroid.norm()});
   }
@@ -145,13 +162,14 @@ void SurfacePass::prepare(const FrameDescription& frame, const Mat3& rotation, c
     const auto box = m.mesh->bounds();
     const Vec3 centre = r * (0.5 * (box.lo + box.hi)) + t;
     const Eigen::Matrix4f cameraFromModel = rigidMatrix(r, t);
-    if (m.opacity >= 1.0f) {
-      sign({static_cast<double>(cached.generation)});
-      for (int i = 0; i < 16; ++i) sign({cameraFromModel.data()[i]});
-    }
+    opaqueDraw = m.opacity >= 1.0f;
+    flatScreens = flatScreens && opaqueDraw;
+    sign({static_cast<double>(cached.generation)});
+    for (int i = 0; i < 16; ++i) sign({cameraFromModel.data()[i]});
     listDraw({cached.vao, 0, cached.vertexCount, cameraFromModel, {m.colour.r, m.colour.g, m.colour.b, m.opacity},
               centre.norm()});
   }
+  if (!flatScreens) screens_.clear();
   // Transparent: far to near (stable: equal distances keep the input order).
   std::stable_sort(transparent_.begin(), transparent_.end(),
                    [](const Draw& a, const Draw& b) { return a.distance > b.distance; });

@@ -15,6 +15,13 @@
 
 namespace rocklab::render::detail {
 
+/// The plane of a flat transparent wall in the camera frame, oriented away from the
+/// eye: a point x lies beyond it (on the far side) when normal · x + offset > 0.
+struct Screen {
+  geometry::Vec3 normal;  // unit
+  double offset;          // m, < 0 (the eye is on the near side)
+};
+
 class SurfacePass {
  public:
   explicit SurfacePass(const GlApi& gl);
@@ -30,6 +37,11 @@ class SurfacePass {
   void drawTransparent(const ViewUniforms& view) const;
   /// Everything the opaque layer depends on, in camera frame (equal ⇒ same pixels).
   const std::vector<double>& opaqueSignature() const { return signature_; }
+  /// The same for the transparent walls.
+  const std::vector<double>& transparentSignature() const { return transparentSignature_; }
+  /// The transparent walls' planes, when every one is a flat polygon the eye does not
+  /// lie in (a transparent mesh, or none: empty).
+  const std::vector<Screen>& screens() const { return screens_; }
 
  private:
   struct Draw {
@@ -59,7 +71,8 @@ class SurfacePass {
   std::unordered_map<const geometry::TriangleMesh*, CachedMesh> meshes_;
   std::uint64_t meshGeneration_ = 0;
   std::vector<Draw> opaque_, transparent_;
-  std::vector<double> signature_;
+  std::vector<double> signature_, transparentSignature_;
+  std::vector<Screen> screens_;
 };
 
 }  // namespace rocklab::render::detail

@@ -84,6 +84,10 @@ class Renderer {
   std::string glVersion() const;   // e.g. "4.5 (Core Profile) Mesa 22.3.6"
   std::string glRenderer() const;  // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   bool coreProfile() const;        // false when the compatibility fallback was taken
+  /// Whether the last frame laid its transparent walls over on the CPU (in every
+  /// motion-blur subframe every sphere in view lay beyond them: render/src/screen_layer.h)
+  /// instead of blending them in GL.
+  bool transparentWallsLaidOver() const;
 
  private:
   struct Impl;
