@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "cli_support.h"
+#include "crusher/breakage_freeze.h"
 #include "crusher/breakage_model.h"
 #include "crusher_support.h"
 #include "drivers/crusher_breakage.h"
@@ -133,6 +134,47 @@ sim::Energy energyAfterStep(std::unique_ptr<sim::World>& world) {
 }
 
 }  // namespace
+
+TEST_CASE("the fragments' overlaps found through a grid equal those of every ball against every fragment, bit for bit",
+          "[experiments][crusher]") {
+  // A loose heap of 3,000 balls of 2-14 mm, a hundred of them fragments, many touching.
+  sim::Model model;
+  model.materials.emplace_back();
+  model.materials.back().kn = 1e6;
+  model.materials.push_back(model.materials.back());
+  model.materials.back().kn = 3e5;  // the fragments' freeze stiffness
+  sim::ParticleState p;
+  geometry::Rng rng(7);
+  std::vector<std::uint32_t> fragments;
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    const double r = rng.uniform(0.001, 0.007);
+    const bool fragment = i % 30 == 0;
+    // (fragmentOverlaps reads positions, radii and materials only)
+    p.position.emplace_back(rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(-0.05, 0.05));
+    p.radius.push_back(r);
+    p.material.push_back(fragment ? 1 : 0);
+    if (fragment) fragments.push_back(i);
+  }
+  crusher::FragmentOverlaps all;
+  std::vector<bool> is_fragment(p.size(), false);
+  for (const std::uint32_t f : fragments) is_fragment[f] = true;
+  int touching = 0;
+  for (const std::uint32_t f : fragments)
+    for (std::uint32_t j = 0; j < p.size(); ++j) {
+      if (j == f || (is_fragment[j] && j < f)) continue;
+      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+      if (!(overlap > 0)) continue;
+      ++touching;
+      all.max_fraction = std::max(all.max_fraction, overlap / std::min(p.radius[f], p.radius[j]));
+      const double kf = model.materials[p.material[f]].kn, kj = model.materials[p.material[j]].kn;
+      all.energy += 0.5 * kf * kj / (kf + kj) * overlap * overlap;
+    }
+  REQUIRE(touching > 50);
+  const crusher::FragmentOverlaps grid = crusher::fragmentOverlaps(model, p, fragments);
+  CHECK(grid.max_fraction == all.max_fraction);
+  CHECK(grid.energy == all.energy);
+  CHECK(crusher::fragmentOverlaps(model, p, {}).energy == 0.0);
+}
 
 TEST_CASE("a ball between two closing walls breaks when q exceeds its strength and not before, and the freeze parts the "
           "fragments without creating energy",
