@@ -157,22 +157,25 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
   std::sort(cells.begin(), cells.end());
   std::vector<bool> is_fragment(p.size(), false);
   for (const std::uint32_t f : fragments) is_fragment[f] = true;
-  std::vector<std::uint32_t> near;
+  std::vector<std::pair<std::uint32_t, double>> touching;  // (ball, overlap) of one fragment
   for (const std::uint32_t f : fragments) {
-    near.clear();
+    touching.clear();
     const Eigen::Vector3i c = cellOf(p.position[f]);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const std::uint64_t k = key(c + Eigen::Vector3i(dx, dy, dz));
           auto it = std::lower_bound(cells.begin(), cells.end(), std::pair{k, std::uint32_t{0}});
-          for (; it != cells.end() && it->first == k; ++it) near.push_back(it->second);
+          for (; it != cells.end() && it->first == k; ++it) {
+            const std::uint32_t j = it->second;
+            if (j == f || (is_fragment[j] && j < f)) continue;  // each fragment pair once
+            const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+            if (overlap > 0) touching.emplace_back(j, overlap);
+          }
         }
-    std::sort(near.begin(), near.end());  // ball order: the sums as over every ball
-    for (const std::uint32_t j : near) {
-      if (j == f || (is_fragment[j] && j < f)) continue;  // each fragment pair once
-      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
-      if (!(overlap > 0)) continue;
+    // In ball order, the few that touch: the sums as over every ball.
+    std::sort(touching.begin(), touching.end());
+    for (const auto& [j, overlap] : touching) {
       o.max_fraction = std::max(o.max_fraction, overlap / std::min(p.radius[f], p.radius[j]));
       const double kf = model.materials[p.material[f]].kn, kj = model.materials[p.material[j]].kn;
       o.energy += 0.5 * kf * kj / (kf + kj) * overlap * overlap;
