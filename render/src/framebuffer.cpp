@@ -41,19 +41,11 @@ void Framebuffer::bindForDrawing() const {
   gl_.Viewport(0, 0, width_, height_);
 }
 
-void Framebuffer::blitTo(const Framebuffer& target) const {
+void Framebuffer::blitTo(const Framebuffer& target, GLbitfield buffers) const {
   gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
   gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, target.fbo_);
-  gl_.BlitFramebuffer(0, 0, width_, height_, 0, 0, target.width_, target.height_,
-                      GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  gl_.BlitFramebuffer(0, 0, width_, height_, 0, 0, target.width_, target.height_, buffers, GL_NEAREST);
   gl_.check("blitting a framebuffer");
-}
-
-void Framebuffer::blitDepthTo(const Framebuffer& target) const {
-  gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
-  gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, target.fbo_);
-  gl_.BlitFramebuffer(0, 0, width_, height_, 0, 0, target.width_, target.height_, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-  gl_.check("blitting a depth buffer");
 }
 
 void Framebuffer::read(cv::Mat& rgba) const {

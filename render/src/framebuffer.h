@@ -17,9 +17,9 @@ class Framebuffer {
   Framebuffer& operator=(const Framebuffer&) = delete;
 
   void bindForDrawing() const;
-  /// Copies colour and depth (or only depth) into `target` (same size), resolving samples.
-  void blitTo(const Framebuffer& target) const;
-  void blitDepthTo(const Framebuffer& target) const;
+  /// Copies `buffers` (colour and depth, or one of them) into `target` (same size),
+  /// resolving samples.
+  void blitTo(const Framebuffer& target, GLbitfield buffers = GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT) const;
   /// Reads the pixels into `rgba`, reallocated if needed: CV_8UC4 (RGBA8, the
   /// renderbuffer's own channel order, so a plain copy) or CV_32FC4 (RGBA32F).
   /// Single-sampled only. GL row 0 goes to image row 0: the projection puts v = 0

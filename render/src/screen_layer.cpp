@@ -16,7 +16,7 @@ ScreenLayer::ScreenLayer(const GlApi& gl, int width, int height)
 void ScreenLayer::update(const std::vector<double>& key, const Framebuffer& opaque, const SurfacePass& surfaces,
                          const ViewUniforms& view) {
   if (key == key_) return;
-  opaque.blitDepthTo(layer_);
+  opaque.blitTo(layer_, GL_DEPTH_BUFFER_BIT);
   layer_.bindForDrawing();
   gl_.ClearColor(0.0f, 0.0f, 0.0f, 0.0f);
   gl_.Clear(GL_COLOR_BUFFER_BIT);
