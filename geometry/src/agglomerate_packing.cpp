@@ -12,7 +12,7 @@
 #include "parameter_check.h"
 #include "power_cells.h"
 #include "rocklab/geometry/tangent_sphere.h"
-#include "sphere_hash_grid.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 
 namespace rocklab::geometry {
 
@@ -53,7 +53,7 @@ void countFailure(TangentFailure failure, VoidFillReport& r) {
 // Steps 3 and 4 for one group: the sphere to add to its void, if any; the outcome
 // is counted in the report.
 std::optional<Sphere> fillOneVoid(const std::array<Sphere, 4>& group, const VoidFillParams& params,
-                                  const detail::SphereHashGrid& grid,
+                                  const SphereHashGrid& grid,
                                   const detail::GrowSettings& grow, VoidFillReport& report) {
   const TangentSolution solution = innerTangentSphere(group);
   if (!solution.sphere) {
@@ -99,7 +99,7 @@ VoidFillResult fillVoids(const std::vector<Sphere>& pack, const VoidFillParams& 
     r_largest = std::max(r_largest, pack[i].radius);
   }
   // Cell: the largest contact distance (both spheres at the largest radius, plus the gap).
-  detail::SphereHashGrid grid{r_largest * (2.0 + params.gap_tolerance), {}};
+  SphereHashGrid grid{r_largest * (2.0 + params.gap_tolerance), {}};
   for (const Sphere& s : out.spheres) grid.insert(s);
   detail::GrowSettings grow;
   grow.r_start = params.r_max / params.r0;  // r_min, Eq 5-11

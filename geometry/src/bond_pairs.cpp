@@ -5,7 +5,7 @@
 #include <string>
 
 #include "parameter_check.h"
-#include "sphere_hash_grid.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 
 namespace rocklab::geometry {
 
@@ -30,11 +30,11 @@ std::vector<SpherePair> bondPairs(const std::vector<Sphere>& spheres, double gap
   }
   if (spheres.empty()) return {};
   // The farthest bonded partner is 2 r_max (1 + tolerance/2) away: one cell covers it.
-  detail::SphereHashGrid grid{r_max * (2.0 + gap_tolerance), {}};
+  SphereHashGrid grid{r_max * (2.0 + gap_tolerance), {}};
   for (std::size_t i = 0; i < spheres.size(); ++i) grid.insert(spheres[i], i);
   std::vector<SpherePair> pairs;
   for (std::size_t i = 0; i < spheres.size(); ++i)
-    grid.forEachNear(spheres[i].centre, [&](const detail::SphereHashGrid::Entry& e) {
+    grid.forEachNear(spheres[i].centre, [&](const SphereHashGrid::Entry& e) {
       if (e.id > i && withinBondGap(spheres[i], e.sphere, gap_tolerance))
         pairs.emplace_back(i, e.id);
     });

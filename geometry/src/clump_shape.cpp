@@ -14,7 +14,7 @@
 #include <unordered_map>
 #include <utility>
 
-#include "sphere_hash_grid.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 
 namespace rocklab::geometry {
 
@@ -282,7 +282,7 @@ std::vector<BodyPose> randomNonOverlappingBodies(const std::vector<const std::ve
   for (const Sphere& s : existing) r_max = std::max(r_max, s.radius);
   std::vector<BodyPose> poses;
   if (shapes.empty()) return poses;
-  detail::SphereHashGrid grid{2.0 * r_max, {}};
+  SphereHashGrid grid{2.0 * r_max, {}};
   for (const Sphere& s : existing) grid.insert(s);
 
   poses.reserve(shapes.size());

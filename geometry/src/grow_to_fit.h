@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "rocklab/geometry/packing.h"
-#include "sphere_hash_grid.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 
 namespace rocklab::geometry::detail {
 

@@ -4,7 +4,7 @@
 #include <unordered_map>
 
 #include "rocklab/geometry/mix64.h"
-#include "sphere_hash_grid.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 
 namespace rocklab::geometry {
 
@@ -39,7 +39,7 @@ std::vector<Vec3> randomNonOverlapping(const std::vector<double>& radii, const V
   double r_max = 0;
   for (double r : radii) r_max = std::max(r_max, r);
   for (const Sphere& s : existing) r_max = std::max(r_max, s.radius);
-  detail::SphereHashGrid grid{2.0 * r_max, {}};
+  SphereHashGrid grid{2.0 * r_max, {}};
   // Spheres larger than a cell would be missed by the 27-cell query: the cell is
   // set by the largest radius, so every overlap partner is in a neighbour cell.
   for (const Sphere& s : existing) grid.insert(s);

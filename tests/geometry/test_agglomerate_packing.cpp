@@ -53,7 +53,7 @@ TEST_CASE(
     "[geometry]") {
   // Four touching unit spheres (edge 2): the void's tangent sphere has r = √6/2 − 1.
   const double h = 2.0 / std::sqrt(2.0) / 2;
-  detail::SphereHashGrid grid{2.0 * 1.001, {}};
+  SphereHashGrid grid{2.0 * 1.001, {}};
   for (const Vec3& c : {Vec3(h, h, h), Vec3(h, -h, -h), Vec3(-h, h, -h), Vec3(-h, -h, h)})
     grid.insert({c, 1.0});
   detail::GrowSettings g;
@@ -68,7 +68,7 @@ TEST_CASE(
   CHECK(grown->radius > 0.9 * tangent);
   CHECK_FALSE(detail::overlapsAny(*grown, grid));
   int contacts = 0;
-  grid.forEachNear(grown->centre, [&](const detail::SphereHashGrid::Entry& e) {
+  grid.forEachNear(grown->centre, [&](const SphereHashGrid::Entry& e) {
     contacts += withinBondGap(*grown, e.sphere, 1e-3);
   });
   CHECK(contacts >= 3);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "rocklab/experiments/run.h"
+#include "rocklab/geometry/sphere_hash_grid.h"
 #include "rocklab/sim/timestep.h"
 #include "rocklab/sim/wall_motion.h"
 
@@ -138,43 +139,27 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
   FragmentOverlaps o;
   if (fragments.empty()) return o;
   // The balls that can touch a fragment, from a grid of cells one largest diameter
-  // wide: a touching pair lies in neighbouring cells. (Every ball against every
-  // fragment took four fifths of a run's time once a weak feed had broken into
-  // thousands of balls and hundreds of fragments froze at once.)
-  const double cell = 2.0 * *std::max_element(p.radius.begin(), p.radius.end());
-  if (!(cell > 0)) return o;
-  const auto cellOf = [&](const Vec3& x) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(x.x() / cell)), static_cast<int>(std::floor(x.y() / cell)),
-                           static_cast<int>(std::floor(x.z() / cell)));
-  };
-  // 21 bits a coordinate: cells of a few centimetres over kilometres.
-  const auto key = [](const Eigen::Vector3i& c) {
-    const auto part = [](int v) { return static_cast<std::uint64_t>(v + (1 << 20)) & ((1u << 21) - 1); };
-    return (part(c.x()) << 42) | (part(c.y()) << 21) | part(c.z());
-  };
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells(p.size());
-  for (std::uint32_t j = 0; j < p.size(); ++j) cells[j] = {key(cellOf(p.position[j])), j};
-  std::sort(cells.begin(), cells.end());
+  // wide (every ball against every fragment took four fifths of a run's time once a
+  // weak feed had broken into thousands of balls and hundreds of fragments froze).
+  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
+  if (!(r_max > 0)) return o;
+  geometry::SphereHashGrid grid{2.0 * r_max, {}};
+  for (std::uint32_t j = 0; j < p.size(); ++j) grid.insert({p.position[j], p.radius[j]}, j);
   std::vector<bool> is_fragment(p.size(), false);
   for (const std::uint32_t f : fragments) is_fragment[f] = true;
   std::vector<std::pair<std::uint32_t, double>> touching;  // (ball, overlap) of one fragment
   for (const std::uint32_t f : fragments) {
     touching.clear();
-    const Eigen::Vector3i c = cellOf(p.position[f]);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const std::uint64_t k = key(c + Eigen::Vector3i(dx, dy, dz));
-          auto it = std::lower_bound(cells.begin(), cells.end(), std::pair{k, std::uint32_t{0}});
-          for (; it != cells.end() && it->first == k; ++it) {
-            const std::uint32_t j = it->second;
-            if (j == f || (is_fragment[j] && j < f)) continue;  // each fragment pair once
-            const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
-            if (overlap > 0) touching.emplace_back(j, overlap);
-          }
-        }
-    // In ball order, the few that touch: the sums as over every ball.
+    grid.forEachNear(p.position[f], [&](const geometry::SphereHashGrid::Entry& e) {
+      const auto j = static_cast<std::uint32_t>(e.id);
+      if (j == f || (is_fragment[j] && j < f)) return;  // each fragment pair once
+      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+      if (overlap > 0) touching.emplace_back(j, overlap);
+    });
+    // In ball order, the few that touch: the sums as over every ball. (Colliding
+    // cell keys visit a cell twice: its balls once.)
     std::sort(touching.begin(), touching.end());
+    touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
     for (const auto& [j, overlap] : touching) {
       o.max_fraction = std::max(o.max_fraction, overlap / std::min(p.radius[f], p.radius[j]));
       const double kf = model.materials[p.material[f]].kn, kj = model.materials[p.material[j]].kn;

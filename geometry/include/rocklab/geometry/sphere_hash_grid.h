@@ -3,7 +3,8 @@
 // pairs, void filling). The cell is at least the largest interaction distance (twice
 // the largest radius, plus any gap allowance), so every partner of a query lies in
 // one of the 27 neighbour cells. Visits are in a fixed order (cells dz, dy, dx, then
-// insertion order), so callers are deterministic. Internal to rocklab_geometry.
+// insertion order), so callers are deterministic; cells whose keys collide are both
+// visited, so a caller that collects pairs removes repeats.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -13,7 +14,7 @@
 
 #include "rocklab/geometry/packing.h"
 
-namespace rocklab::geometry::detail {
+namespace rocklab::geometry {
 
 struct SphereHashGrid {
   struct Entry {
@@ -65,4 +66,4 @@ struct SphereHashGrid {
   }
 };
 
-}  // namespace rocklab::geometry::detail
+}  // namespace rocklab::geometry
