@@ -212,9 +212,9 @@ TEST_CASE("a second Ctrl-C ends the process at once", "[cli]") {
   fs::remove_all(out);
 }
 
-TEST_CASE("restart refuses an experiment scene and writes nothing", "[cli]") {
-  // An experiment's phase is not in the checkpoint: continuing would run it from
-  // its first phase on a later state.
+TEST_CASE("restart refuses an experiment scene that saves no state and writes nothing", "[cli]") {
+  // The drop test's phase is not in the checkpoint (only the crusher's driver saves
+  // its state): continuing would run it from its first phase on a later state.
   const fs::path out = tempDir("drop"), out2 = tempDir("drop-restart");
   REQUIRE(cli({"run", "drop", "--out", out.string(), "--quiet", "--set", "scene.end_time=0.01", "--set",
                "output.checkpoint=true"}) == 0);
@@ -223,7 +223,7 @@ TEST_CASE("restart refuses an experiment scene and writes nothing", "[cli]") {
                                       "--quiet", "--set", "scene.end_time=0.02"});
   CHECK(code == 2);
   CHECK_THAT(log, Catch::Contains("experiment.drop scenes cannot be restarted from a checkpoint"));
-  CHECK_THAT(log, Catch::Contains("error: " + (out / "checkpoint.h5").string() + ": "));  // names the file
+  CHECK_THAT(log, Catch::Contains("error: checkpoint '" + (out / "checkpoint.h5").string() + "': "));  // names the file
   CHECK_FALSE(fs::exists(out2));
   fs::remove_all(out);
 }

@@ -175,3 +175,33 @@ TEST_CASE("settle_bond_factor keeps a feed whole on the stop wall and gives the 
   CHECK(log.find("crusher.stop") != std::string::npos);
   fs::remove_all(dir);
 }
+
+TEST_CASE("a bonded crusher feed restarted while its bonds are held strong ends as the straight run, bit for bit",
+          "[crusher][bonds][restart]") {
+  // The checkpoint at 0.3 s holds the strengthened bonds and the strengths to give
+  // back when the stop wall goes at 0.4 s: the restart must give them back and break
+  // the feed as the run that went straight through.
+  const fs::path dir = test::scratchDir("bonded-restart");
+  fs::create_directories(dir);
+  std::string scene = feedScene(agglomerates(2, "0.2", "0.23"), kStopWall, 2e4);
+  scene.replace(scene.find("checkpoint = false"), 18, "checkpoint = true");
+  std::ofstream(dir / "scene.toml") << scene;
+  const auto runTo = [&](const std::string& out, const std::string& end) {
+    return test::cli({"run", (dir / "scene.toml").string(), "--out", (dir / out).string(), "--threads", "1", "--quiet",
+                      "--set", "experiment.settle_bond_factor=10000", "--set", "scene.end_time=" + end});
+  };
+  REQUIRE(runTo("straight", "0.8") == 0);
+  REQUIRE(runTo("first", "0.3") == 0);
+  REQUIRE(test::cli({"restart", (dir / "first" / "checkpoint.h5").string(), "--out", (dir / "second").string(),
+                     "--quiet", "--set", "scene.end_time=0.8"}) == 0);
+  const auto results = [&](const std::string& out) {
+    std::ifstream in(dir / out / "results.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json straight = results("straight"), second = results("second");
+  CHECK(straight["crusher"]["discharged_balls"].get<int>() > 2);  // it broke after the release
+  CHECK(second["state_hash"] == straight["state_hash"]);
+  CHECK(second["crusher"] == straight["crusher"]);  // no moving wall: the power is 0 in both
+  CHECK(test::slurp(dir / "second" / "product.csv") == test::slurp(dir / "straight" / "product.csv"));
+  fs::remove_all(dir);
+}

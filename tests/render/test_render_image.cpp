@@ -150,7 +150,7 @@ TEST_CASE("the compatibility fallback draws the same image as the core profile, 
   CHECK(cv::norm(a, b, cv::NORM_INF) <= 1);
   cv::Mat differs;
   cv::cvtColor(cv::abs(a - b) + cv::abs(b - a), differs, cv::COLOR_BGR2GRAY);
-  CHECK(cv::countNonZero(differs) <= a.total() / 1000);
+  CHECK(static_cast<std::size_t>(cv::countNonZero(differs)) <= a.total() / 1000);
 }
 
 TEST_CASE("transparent walls laid over on the CPU match blending them in GL to one level", "[render]") {

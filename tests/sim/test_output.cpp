@@ -596,6 +596,7 @@ WorldState awkwardState() {
   state.step = (std::uint64_t{1} << 40) + 7;
   state.dt = 1e-6 / 3.0;  // s
   state.half_kick_pending = false;
+  state.moving_wall_work = -1.0 / 3.0;  // J
   auto& p = state.particles;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double tiny = std::numeric_limits<double>::denorm_min();
@@ -632,6 +633,7 @@ void checkSameState(const WorldState& read, const WorldState& written) {
   CHECK(read.step == written.step);
   CHECK(sameBits(read.dt, written.dt));
   CHECK(read.half_kick_pending == written.half_kick_pending);
+  CHECK(sameBits(read.moving_wall_work, written.moving_wall_work));
   const auto& r = read.particles;
   const auto& w = written.particles;
   CHECK(sameBits(r.position, w.position));
@@ -688,6 +690,13 @@ TEST_CASE("output: checkpoint round trip keeps every bit", "[output]") {
     const output::Checkpoint read = output::readCheckpoint(path);
     CHECK(read.scene_text == kScene);
     checkSameState(read.state, state);
+  }
+  SECTION("an experiment's state: its bytes as they were, and none when none was saved") {
+    const std::vector<std::uint8_t> bytes{0xa1, 0x00, 0xff, 0x7f, 0x00};
+    output::writeCheckpoint(path, awkwardState(), kScene, bytes);
+    CHECK(output::readCheckpoint(path).experiment_state == bytes);
+    output::writeCheckpoint(path, awkwardState(), kScene);
+    CHECK(output::readCheckpoint(path).experiment_state.empty());
   }
   SECTION("no particles") {
     const WorldState state;  // half_kick_pending = true, empty arrays

@@ -18,6 +18,7 @@ struct ProductBall {
   double time = 0, diameter = 0, mass = 0;  // s (discharge), m, kg
   double residence = 0;                     // s in the chamber (NaN: entry not seen)
 };
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ProductBall, id, time, diameter, mass, residence)
 
 /// The size (m) that `fraction` (0-1) of the mass is finer than, on the product's
 /// own cumulative curve: the balls sorted by diameter, the curve through (d_k,
@@ -48,6 +49,9 @@ class ChamberEntries {
  private:
   double top_;
   std::map<std::uint64_t, double> entered_;
+
+ public:
+  NLOHMANN_DEFINE_TYPE_INTRUSIVE(ChamberEntries, entered_)  // a restart's state (the top is the scene's)
 };
 
 /// A drive's power over consecutive intervals: each sample is the mean power of
@@ -72,6 +76,10 @@ class PowerMeter {
   double bin_start_ = 0, bin_energy_ = 0, bin_span_ = 0;
   std::vector<std::pair<double, double>> series_;
   bool loaded_ = false;
+
+ public:
+  NLOHMANN_DEFINE_TYPE_INTRUSIVE(PowerMeter, energy_, first_loaded_, last_loaded_, samples_, bin_start_, bin_energy_,
+                                 bin_span_, series_, loaded_)  // a restart's state (the bin is the scene's)
 };
 
 /// results.json's product statistics: p50_mm, p80_mm, throughput_tph (product

@@ -82,6 +82,10 @@ const char* crowdedBoundName(BreakageSettings::CrowdedBound bound) {
   return bound == BreakageSettings::CrowdedBound::Overlap ? "overlap" : "energy";
 }
 
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(BreakageEvent, time, parent, diameter, q, strength, fragments, freeze_cycles,
+                                   freeze_end, freeze_overlap, freeze_contact_times, kinetic_jump, mass, parent_energy,
+                                   handed_back_energy, fragment_diameters, fragment_masses)
+
 namespace {
 
 // The kinetic-energy jump after a breakage is followed for this many contact
@@ -122,18 +126,87 @@ int CrusherBreakage::fragmentMaterial(sim::Model& model, int material, double di
   const int size_class = static_cast<int>(std::floor(std::log(diameter / s_.min_diameter) / std::log(s_.class_ratio)));
   const auto [it, added] = class_material_.try_emplace({base, size_class}, static_cast<int>(model.materials.size()));
   if (!added) return it->second;
+  model.materials.push_back(classMaterial(model.materials[base], base, size_class));
+  base_of_[it->second] = base;
+  return it->second;
+}
+
+sim::Material CrusherBreakage::classMaterial(const sim::Material& feed, int feed_index, int size_class) const {
   // k = 4 R E_c (Eq 6-14) at the class's geometric middle; the shear stiffness in
   // the feed material's ratio.
-  const sim::Material& feed = model.materials[base];
   sim::Material m = feed;
   const double lo = s_.min_diameter * std::pow(s_.class_ratio, size_class), hi = lo * s_.class_ratio;
   m.name = feed.name + " fragments " + mm(lo) + "-" + mm(hi) + " mm";
   m.kn = 2.0 * lo * std::sqrt(s_.class_ratio) * s_.youngs_modulus;
   m.ks = m.kn * (feed.kn > 0 ? feed.ks / feed.kn : 1.0);
-  m.made_from = base;  // drawn in the feed's colour (run.h5 /materials)
-  model.materials.push_back(m);
-  base_of_[it->second] = base;
-  return it->second;
+  m.made_from = feed_index;  // drawn in the feed's colour (run.h5 /materials)
+  return m;
+}
+
+nlohmann::json CrusherBreakage::saveState() const {
+  nlohmann::json j;
+  j["check_interval"] = check_interval_;
+  j["every"] = every_;
+  j["next_id"] = next_id_;
+  j["class_material"] = class_material_;
+  j["events"] = events_;
+  j["jump_watch"] = jump_watch_ ? nlohmann::json(*jump_watch_) : nlohmann::json(nullptr);
+  j["deferrals"] = deferrals_;
+  j["deferred_until"] = deferred_until_;
+  j["fragments_created"] = fragments_created_;
+  j["freezes"] = freezes_;
+  j["freeze_cycles"] = freeze_cycles_;
+  j["max_freeze_cycles"] = max_freeze_cycles_;
+  j["freezes_stalled"] = freezes_stalled_;
+  j["freezes_crowded"] = freezes_crowded_;
+  j["max_freeze_balls"] = max_freeze_balls_;
+  j["reach_widenings"] = reach_widenings_;
+  j["moved_neighbours"] = moved_neighbours_;
+  j["max_freeze_overlap"] = max_freeze_overlap_;
+  j["max_crowded_overlap"] = max_crowded_overlap_;
+  j["max_crowded_handed_back"] = max_crowded_handed_back_;
+  j["max_excess"] = max_excess_;  // -inf before the first kept freeze: CBOR keeps it
+  return j;
+}
+
+void CrusherBreakage::restoreState(const nlohmann::json& j, sim::Model& model) {
+  j.at("check_interval").get_to(check_interval_);
+  j.at("every").get_to(every_);
+  j.at("next_id").get_to(next_id_);
+  j.at("class_material").get_to(class_material_);
+  j.at("events").get_to(events_);
+  jump_watch_.reset();
+  if (!j.at("jump_watch").is_null()) jump_watch_ = j.at("jump_watch").get<JumpWatch>();
+  j.at("deferrals").get_to(deferrals_);
+  j.at("deferred_until").get_to(deferred_until_);
+  j.at("fragments_created").get_to(fragments_created_);
+  j.at("freezes").get_to(freezes_);
+  j.at("freeze_cycles").get_to(freeze_cycles_);
+  j.at("max_freeze_cycles").get_to(max_freeze_cycles_);
+  j.at("freezes_stalled").get_to(freezes_stalled_);
+  j.at("freezes_crowded").get_to(freezes_crowded_);
+  j.at("max_freeze_balls").get_to(max_freeze_balls_);
+  j.at("reach_widenings").get_to(reach_widenings_);
+  j.at("moved_neighbours").get_to(moved_neighbours_);
+  j.at("max_freeze_overlap").get_to(max_freeze_overlap_);
+  j.at("max_crowded_overlap").get_to(max_crowded_overlap_);
+  j.at("max_crowded_handed_back").get_to(max_crowded_handed_back_);
+  j.at("max_excess").get_to(max_excess_);
+  if (every_ == 0) throw std::invalid_argument("breakage check every 0 steps (allowed: at least 1)");
+  // The fragment materials in the order the run added them after the scene's.
+  std::vector<std::pair<int, std::pair<int, int>>> added;  // (material, (feed material, class))
+  for (const auto& [key, material] : class_material_) added.push_back({material, key});
+  std::sort(added.begin(), added.end());
+  base_of_.clear();
+  for (const auto& [material, key] : added) {
+    const auto [base, size_class] = key;
+    if (material != static_cast<int>(model.materials.size()) || base < 0 || base >= material)
+      throw std::invalid_argument("fragment material " + std::to_string(material) + " of feed material " +
+                                  std::to_string(base) + " does not follow the scene's " +
+                                  std::to_string(model.materials.size()) + " materials");
+    model.materials.push_back(classMaterial(model.materials[base], base, size_class));
+    base_of_[material] = base;
+  }
 }
 
 void CrusherBreakage::start(const sim::World& world) {
@@ -210,6 +283,7 @@ void CrusherBreakage::watchKineticJump(const sim::World& world) {
 }
 
 bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+  interrupted_ = false;
   watchKineticJump(*world);
   if (world->stepCount() % every_ != 0) return false;
   const sim::ParticleState& p = world->particles();
@@ -315,6 +389,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   const bool kept = freeze.end != crusher::FreezeEnd::Interrupted &&
                     (!crowded || (s_.freeze.crowded == crusher::CrowdedOutcome::Break && within_bound));
   if (!kept) {
+    interrupted_ = freeze.end == crusher::FreezeEnd::Interrupted;
     events_.resize(first_event);
     next_id_ = next_id_before;
     base_of_ = base_of_before;

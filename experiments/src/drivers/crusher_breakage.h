@@ -115,6 +115,8 @@ class CrusherBreakage {
   /// world after the freeze. Returns whether the world changed.
   bool check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx);
 
+  /// The last check's freeze was cut short by a stop request: nothing changed.
+  bool interrupted() const { return interrupted_; }
   const std::vector<BreakageEvent>& events() const { return events_; }
   /// For the progress line: the events and how the freezes so far ended (the
   /// report is written only at the end of a run).
@@ -123,6 +125,13 @@ class CrusherBreakage {
   /// results.json's crusher.breakage (without the mass balance, which the driver
   /// adds) and breakage.csv.
   nlohmann::json report(const std::vector<double>& sieves_mm, const std::filesystem::path& out_dir) const;
+
+  /// What a restart needs besides the settings and the seed (Experiment::saveState).
+  nlohmann::json saveState() const;
+  /// Puts back what saveState gave, and the fragment materials the run had added
+  /// to `model` (the scene's), in their order. Throws std::invalid_argument (or
+  /// nlohmann::json::exception) when the state does not fit the model.
+  void restoreState(const nlohmann::json& state, sim::Model& model);
 
   /// The material a fragment of `diameter` broken from a ball of `material` gets:
   /// its size class's copy of the feed material (added to `model` when new).
@@ -143,12 +152,15 @@ class CrusherBreakage {
   std::map<int, int> base_of_;                    // fragment material -> the feed material it copies
   std::map<std::pair<int, int>, int> class_material_;  // (feed material, class) -> material
   std::vector<BreakageEvent> events_;
+  /// The copy of `feed` that fragments of `size_class` get (fragmentMaterial).
+  sim::Material classMaterial(const sim::Material& feed, int feed_index, int size_class) const;
   /// Follows the run's kinetic energy after a check that broke balls (BreakageEvent::kinetic_jump).
   void watchKineticJump(const sim::World& world);
   struct JumpWatch {
     double before = 0;  // J, just before the check
     double until = 0;   // s
     std::size_t first_event = 0, end_event = 0;
+    NLOHMANN_DEFINE_TYPE_INTRUSIVE(JumpWatch, before, until, first_event, end_event)
   };
   std::optional<JumpWatch> jump_watch_;
   struct Deferral {  // a crowded freeze: its time, parents, cycles and the overlap it left
@@ -157,10 +169,12 @@ class CrusherBreakage {
     std::uint64_t cycles = 0;
     double overlap = 0;
     double parent_energy = 0, handed_back_energy = 0;  // J, as BreakageEvent's (0 with "defer")
+    NLOHMANN_DEFINE_TYPE_INTRUSIVE(Deferral, time, parents, cycles, overlap, parent_energy, handed_back_energy)
   };
   std::vector<Deferral> deferrals_;
   std::map<std::uint64_t, double> deferred_until_;  // id -> time before which it does not break
   std::size_t fragments_created_ = 0;
+  bool interrupted_ = false;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
   std::uint64_t freezes_stalled_ = 0, freezes_crowded_ = 0;  // crowded: kept with freeze_crowded "break"
   double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left

@@ -85,6 +85,9 @@ class CrusherRunExperiment final : public Experiment {
       for (; events_seen_ < events.size(); ++events_seen_)
         entries_.inherit(events[events_seen_].parent, events[events_seen_].fragments);
     }
+    // A stop request cut the freeze short: no discharge either, so that a restart
+    // redoes this step's check and discharge in their order (advanceUndone).
+    if (breakage_.interrupted()) return true;
     if (world->stepCount() % every_ != 0) return true;
     meterPower(*world);
     if (bonded_) {
@@ -214,6 +217,67 @@ class CrusherRunExperiment final : public Experiment {
     });
     strengthened_ = false;
     restored_at_ = world->time();
+  }
+
+  bool restartable() const override { return true; }
+  // What came before the check in advance() is done once (the strengths given back)
+  // or the same when done again (the kinetic-energy watch).
+  bool advanceUndone() const override { return breakage_.interrupted(); }
+
+  nlohmann::json saveState() const override {
+    nlohmann::json j;
+    j["started"] = started_;
+    j["every"] = every_;
+    j["chamber_mass"] = chamber_mass_;
+    j["product"] = product_;
+    j["feed"] = feed_;
+    j["breakage"] = e_.breakage.enabled ? breakage_.saveState() : nlohmann::json(nullptr);
+    j["entries"] = entries_;
+    j["power"] = power_;
+    j["metered_work"] = metered_work_;
+    j["metered_time"] = metered_time_;
+    j["events_seen"] = events_seen_;
+    j["bonded"] = bonded_;
+    j["porosity"] = porosity_;
+    j["fragment_balls"] = fragment_balls_;
+    j["strengthened"] = strengthened_;
+    j["restored_at"] = restored_at_;  // NaN until the strengths are restored: CBOR keeps it
+    j["tensile"] = tensile_;
+    j["shear"] = shear_;
+    j["bonds_at_start"] = bonds_at_start_;
+    j["bonds_intact"] = bonds_intact_;
+    j["intact_at_release"] = intact_at_release_;
+    return j;
+  }
+
+  void restoreState(const nlohmann::json& j, sim::Model& model) override {
+    j.at("started").get_to(started_);
+    j.at("every").get_to(every_);
+    j.at("chamber_mass").get_to(chamber_mass_);
+    j.at("product").get_to(product_);
+    j.at("feed").get_to(feed_);
+    if (const nlohmann::json& b = j.at("breakage"); b.is_null() == e_.breakage.enabled)
+      throw std::invalid_argument(std::string("the run was saved ") + (b.is_null() ? "without" : "with") +
+                                  " [experiment.breakage] and the scene now has " +
+                                  (e_.breakage.enabled ? "it" : "none") + ": restart with the table as it was");
+    else if (e_.breakage.enabled)
+      breakage_.restoreState(b, model);
+    j.at("entries").get_to(entries_);
+    j.at("power").get_to(power_);
+    j.at("metered_work").get_to(metered_work_);
+    j.at("metered_time").get_to(metered_time_);
+    j.at("events_seen").get_to(events_seen_);
+    j.at("bonded").get_to(bonded_);
+    j.at("porosity").get_to(porosity_);
+    j.at("fragment_balls").get_to(fragment_balls_);
+    j.at("strengthened").get_to(strengthened_);
+    j.at("restored_at").get_to(restored_at_);
+    j.at("tensile").get_to(tensile_);
+    j.at("shear").get_to(shear_);
+    j.at("bonds_at_start").get_to(bonds_at_start_);
+    j.at("bonds_intact").get_to(bonds_intact_);
+    j.at("intact_at_release").get_to(intact_at_release_);
+    if (every_ == 0) throw std::invalid_argument("sample every 0 steps (allowed: at least 1)");
   }
 
   std::string progress() const override {

@@ -42,6 +42,21 @@ class Experiment {
   virtual void cameraFrame(std::uint64_t /*frame*/, double /*time*/, const cv::Mat& /*raw*/) {}
   /// A few words for the progress line, e.g. "phase flow, 812 bodies left".
   virtual std::string progress() const { return {}; }
+  /// True when the last advance() was cut short by a stop request (Ctrl-C, SIGTERM)
+  /// and left the driver and the World as they were before it: the run stops
+  /// before stepping, so a restart advances this step again, as an uninterrupted
+  /// run did.
+  virtual bool advanceUndone() const { return false; }
+  /// Restart (`rocklab restart`): whether the driver saves its own state in
+  /// checkpoint.h5 and goes on from it; a restart of one that cannot is refused.
+  virtual bool restartable() const { return false; }
+  /// The driver's state between two steps (a restartable driver).
+  virtual nlohmann::json saveState() const { return nullptr; }
+  /// Puts back what saveState gave, before the World is rebuilt from the
+  /// checkpoint, and adds to `model` (the scene's) what the run had added to its
+  /// own (a breakage's fragment materials). Throws std::invalid_argument or
+  /// nlohmann::json::exception when the state does not fit.
+  virtual void restoreState(const nlohmann::json& /*state*/, sim::Model& /*model*/) {}
   /// Adds the figures to results.json and writes the experiment's CSV and PNG files.
   virtual void report(nlohmann::json& results, const std::filesystem::path& out_dir,
                       std::ostream& log) = 0;

@@ -45,6 +45,11 @@ struct RunSetup {
   std::uint64_t frame_every = 0, energy_every = 0, checkpoint_every = 0;
 };
 
+/// checkpoint.h5's /experiment: CBOR of {experiment: the type that wrote it,
+/// format: this, state: Experiment::saveState()} (run_loop.cpp writes it,
+/// run_setup.cpp reads it).
+inline constexpr int kExperimentStateFormat = 1;
+
 /// Builds the World (new, or from options.restart), the experiment, the cameras
 /// and the output writers, and logs the set-up. Returns kExitOk, or
 /// kExitBadInput with the reason in `log` (then nothing was written), or

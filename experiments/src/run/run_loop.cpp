@@ -144,8 +144,13 @@ class RunLoop {
       return false;
     }
     Experiment* experiment = setup_.experiment.get();
-    if (experiment && !record_.experiment_over)
+    if (experiment && !record_.experiment_over) {
       record_.experiment_over = !experiment->advance(world_, context_);
+      if (experiment->advanceUndone()) {  // the checkpoint is the state before this step's advance
+        stopWith("interrupted", "", kExitInterrupted);
+        return false;
+      }
+    }
     chooseObservations();
     record_.ball_steps += world_->particles().size();
     if (frame_due_ || experiment_due_ || energy_due_ || camera_due_)
@@ -208,8 +213,13 @@ class RunLoop {
   void writeCheckpoint() {
     if (!scene_.run.checkpoint) return;
     const auto t0 = Clock::now();
-    sim::output::writeCheckpoint(options_.out_dir / "checkpoint.h5", world_->exportState(),
-                                 scene_.text);
+    // A restartable experiment's own state beside the World (run_setup.cpp reads it).
+    std::vector<std::uint8_t> experiment_state;
+    if (const Experiment* experiment = setup_.experiment.get(); experiment && experiment->restartable())
+      experiment_state = nlohmann::json::to_cbor(
+          {{"experiment", scene_.experiment_type}, {"format", kExperimentStateFormat}, {"state", experiment->saveState()}});
+    sim::output::writeCheckpoint(options_.out_dir / "checkpoint.h5", world_->exportState(), scene_.text,
+                                 experiment_state);
     record_.checkpoint_step = static_cast<std::int64_t>(world_->stepCount());
     record_.output_seconds += seconds(t0, Clock::now());
   }

@@ -15,17 +15,56 @@ namespace {
 
 namespace out = sim::output;
 
-/// The World where the checkpoint options.restart left it; every value of the
-/// file is checked (World(Model, WorldState)) and a complaint names the file.
-int restartWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
-                 std::unique_ptr<sim::World>& world) {
+/// Puts `experiment` back where the checkpoint's /experiment left it, adding to
+/// `model` what the run had added; "" or what is wrong, naming the dataset.
+std::string restoreExperiment(const Scene& scene, const std::vector<std::uint8_t>& bytes, Experiment& experiment,
+                              sim::Model& model) {
+  const std::string type = "experiment." + scene.experiment_type;
+  if (!experiment.restartable())
+    return type + " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not saved; "
+                  "restartable: experiment.crusher); run the scene again";
+  if (bytes.empty())
+    return "holds no /experiment (the state of the " + type +
+           " driver: written by a run of another scene, or by a rocklab before experiment restarts); run the "
+           "scene again";
+  try {
+    const nlohmann::json saved = nlohmann::json::from_cbor(bytes);
+    const std::string saved_type = saved.at("experiment").get<std::string>();
+    const int format = saved.at("format").get<int>();
+    if (saved_type != scene.experiment_type)
+      return "dataset /experiment: saved by experiment." + saved_type + ", the scene is " + type;
+    if (format != kExperimentStateFormat)
+      return "dataset /experiment: format " + std::to_string(format) + " (this build reads " +
+             std::to_string(kExperimentStateFormat) + ")";
+    experiment.restoreState(saved.at("state"), model);
+  } catch (const nlohmann::json::exception& e) {
+    return "dataset /experiment: not the state of the " + type + " driver this build saves (" + e.what() + ")";
+  } catch (const std::invalid_argument& e) {
+    return "dataset /experiment: " + std::string(e.what());
+  }
+  return {};
+}
+
+/// The World (and the experiment, when the scene has one) where the checkpoint
+/// options.restart left it; every value of the file is checked (World(Model,
+/// WorldState)) and a complaint names the file.
+int restartWorld(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup) {
   const std::string file = "checkpoint '" + options.restart.string() + "': ";
+  std::unique_ptr<sim::World>& world = setup.world;
   try {
     out::Checkpoint cp = out::readCheckpoint(options.restart);
     if (cp.unchecked > 0)
       log << "warning: " << file << cp.unchecked
           << " datasets have no checksum (written before rocklab stored them): read unchecked\n";
-    world = std::make_unique<sim::World>(scene.model, std::move(cp.state), options.threads);
+    sim::Model model = scene.model;
+    if (setup.experiment) {
+      if (const std::string bad = restoreExperiment(scene, cp.experiment_state, *setup.experiment, model);
+          !bad.empty()) {
+        log << "error: " << file << bad << "\n";
+        return kExitBadInput;
+      }
+    }
+    world = std::make_unique<sim::World>(model, std::move(cp.state), options.threads);
   } catch (const out::CheckpointError& e) {
     log << "error: " << e.what() << "\n";
     return kExitBadInput;
@@ -45,11 +84,10 @@ int restartWorld(const Scene& scene, const RunOptions& options, std::ostream& lo
 }
 
 /// The World at t = 0 from the scene, or where options.restart left it.
-int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log,
-              std::unique_ptr<sim::World>& world) {
-  if (!options.restart.empty()) return restartWorld(scene, options, log, world);
+int makeWorld(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup) {
+  if (!options.restart.empty()) return restartWorld(scene, options, log, setup);
   try {
-    world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, scene.bonds, options.threads);
+    setup.world = std::make_unique<sim::World>(scene.model, scene.spheres, scene.clumps, scene.bonds, options.threads);
   } catch (const std::invalid_argument& e) {
     log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string())
         << ": " << e.what() << "\n";
@@ -175,14 +213,8 @@ int makeCameras(const Scene& scene, const RunOptions& options, std::ostream& log
 }  // namespace
 
 int setUpRun(const Scene& scene, const RunOptions& options, std::ostream& log, RunSetup& setup) {
-  if (const int rc = makeWorld(scene, options, log, setup.world); rc != kExitOk) return rc;
   setup.experiment = makeExperiment(scene);
-  if (setup.experiment && !options.restart.empty()) {
-    log << "error: " << scene.source.string() << ": experiment." << scene.experiment_type
-        << " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not "
-           "saved); run the scene again\n";
-    return kExitBadInput;
-  }
+  if (const int rc = makeWorld(scene, options, log, setup); rc != kExitOk) return rc;
   if (const std::string bad = countSteps(scene, setup.world->dt(), !options.restart.empty(), setup); !bad.empty()) {
     log << "error: " << (scene.source.empty() ? std::string("scene") : scene.source.string()) << ": " << bad << "\n";
     return kExitBadInput;

@@ -3,6 +3,7 @@
 #include <H5Cpp.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <system_error>
@@ -117,7 +118,8 @@ constexpr const char* kRunChecksum = "run_crc32";
 
 /// The checkpoint file's bytes, built in memory: HDF5 never meets the disk, so
 /// a full disk is one failed write() with its errno (writeFileAtomically).
-std::string fileImage(const std::string& name, const WorldState& state, const std::string& scene_text) {
+std::string fileImage(const std::string& name, const WorldState& state, const std::string& scene_text,
+                      std::span<const std::uint8_t> experiment_state) {
   detail::FileHandle handle(name, true);
   const H5::Group& file = handle.root();
   writeTextAttribute(file, "format", kFormat);
@@ -133,6 +135,8 @@ std::string fileImage(const std::string& name, const WorldState& state, const st
   writeHistory(file, kPairLayout, state.pair_history);
   writeHistory(file, kWallLayout, state.wall_history);
   writeBonds(file, state.bonds);
+  writeArray(file, "moving_wall_work", std::vector<double>{state.moving_wall_work}, "J");
+  if (!experiment_state.empty()) writeArray(file, "experiment", experiment_state, "");
   std::string image = handle.image();
   handle.close();
   return image;
@@ -341,6 +345,14 @@ Checkpoint readFile(const Reader& in) {
   state.pair_history = readHistory(in, kPairLayout);
   state.wall_history = readHistory(in, kWallLayout);
   state.bonds = readBonds(in);
+  if (in.has("/moving_wall_work")) {
+    const auto work = in.array<double>("/moving_wall_work");
+    if (work.size() != 1) in.fail("dataset /moving_wall_work holds " + std::to_string(work.size()) + " values (expected 1)");
+    if (!std::isfinite(work[0]))
+      in.fail("dataset /moving_wall_work: " + std::to_string(work[0]) + " J (allowed: a finite number)");
+    state.moving_wall_work = work[0];
+  }
+  if (in.has("/experiment")) checkpoint.experiment_state = in.array<std::uint8_t>("/experiment");
   if (const std::string problem = inconsistency(state); !problem.empty()) in.fail(problem);
   checkpoint.unchecked = in.unchecked();
   return checkpoint;
@@ -349,7 +361,7 @@ Checkpoint readFile(const Reader& in) {
 }  // namespace
 
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
-                     const std::string& scene_text) {
+                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state) {
   detail::recordHdf5Errors();  // errors reach the caller as exceptions, with the system's reason
   const std::string what = "cannot write checkpoint " + quoted(path) + ": ";
   if (const std::string problem = inconsistency(state); !problem.empty()) throw CheckpointError(what + problem);
@@ -358,7 +370,7 @@ void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
 
   std::string image;
   try {
-    image = fileImage(path.string(), state, scene_text);
+    image = fileImage(path.string(), state, scene_text, experiment_state);
   } catch (const H5::Exception& e) {
     throw fail(detail::hdf5Failure(e));
   }

@@ -76,8 +76,8 @@ struct WorldState {
   std::vector<WallHistory> wall_history;
   BondState bonds;  // every bond, intact and broken; empty without bonds
   // J, World::movingWallWork() when exported: a World built from the state goes on
-  // counting from it (an experiment that rebuilds its World keeps the total). Not
-  // in checkpoints: a restart counts from 0.
+  // counting from it (an experiment that rebuilds its World keeps the total), and
+  // so does a restart (checkpoints keep it).
   double moving_wall_work = 0.0;
 };
 

@@ -6,12 +6,18 @@
 // Layout: attrs format = "rocklab-checkpoint", version = 1, time, step, dt,
 // half_kick_pending, run_crc32 (CRC-32 of those four); /scene string; /particles/{position, velocity, omega [n,3],
 // radius, inv_mass, inv_inertia, mass [n], material [n] int32, id [n] uint64};
-// /pairs/{i, j [m] uint32, shear [m,3]}; /walls/{particle, wall [k] uint32, shear [k,3]}.
+// /pairs/{i, j [m] uint32, shear [m,3]}; /walls/{particle, wall [k] uint32, shear [k,3]};
+// /moving_wall_work [1] J (absent in files written before it: 0); /experiment [b]
+// uint8, the experiment driver's own state (only an experiment run that saves one:
+// opaque bytes here, CBOR written and read by the experiments library).
 // Doubles are stored as IEEE doubles, so a read gives back the same bits. Every
 // dataset carries "unit" and "crc32" (CRC-32 of its bytes) attributes.
+#include <cstdint>
 #include <filesystem>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "rocklab/sim/world.h"
 
@@ -26,11 +32,12 @@ struct CheckpointError : std::runtime_error {
 /// reason, removes the temporary and leaves an existing checkpoint as it was; a
 /// state whose arrays disagree throws CheckpointError.
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
-                     const std::string& scene_text);
+                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state = {});
 
 struct Checkpoint {
   WorldState state;
   std::string scene_text;
+  std::vector<std::uint8_t> experiment_state;  // empty: the run saved none
   // Datasets (and the block of run attributes) read without a checksum: files
   // written before checksums were stored are read, but unchecked.
   std::size_t unchecked = 0;
