@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <utility>
 #include <vector>
@@ -128,28 +129,44 @@ bool TriangleMeshIndex::closestPointWithin(const Vec3& p, double radius, Vec3& c
   return found;
 }
 
-void TriangleMeshIndex::trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const {
+void TriangleMeshIndex::trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out,
+                                        std::vector<double>* distances) const {
   const Tree& t = *tree_;
-  const std::size_t first = out.size();
   const double r2 = radius * radius;
+  std::vector<std::pair<double, std::uint32_t>> found;  // (distance^2, triangle)
   forTrianglesNear(t.tree, t.triangles, p, radius, [&](std::size_t k) {
-    if ((t.closestOn(k, p) - p).squaredNorm() < r2) out.push_back(static_cast<std::uint32_t>(k));
+    const double d2 = (t.closestOn(k, p) - p).squaredNorm();
+    if (d2 < r2) found.emplace_back(d2, static_cast<std::uint32_t>(k));
   });
-  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+  std::sort(found.begin(), found.end());
+  for (const auto& [d2, k] : found) {
+    out.push_back(k);
+    if (distances) distances->push_back(std::sqrt(d2));
+  }
 }
 
 bool TriangleMeshIndex::closestPointAmong(const Vec3& p, double radius, std::span<const std::uint32_t> triangles,
-                                          Vec3& closest) const {
+                                          Vec3& closest, const CandidateDistances& bounds) const {
   const Tree& t = *tree_;
   double best = radius * radius;
+  std::uint32_t best_triangle = 0;
   bool found = false;
-  // In increasing index order a strict < keeps the first triangle of a tie, as
-  // closestPointWithin's tie rule does.
-  for (const std::uint32_t k : triangles) {
+  const bool bounded = bounds.then.size() == triangles.size();
+  for (std::size_t c = 0; c < triangles.size(); ++c) {
+    if (bounded) {
+      // Nearest first: once a triangle's lower bound is above the best (with a
+      // margin for round-off: metres, distances of mm), so are the rest's; an
+      // equal one is still tested for the tie rule.
+      const double lower = bounds.then[c] * (1 - 1e-9) - bounds.moved - 1e-12;
+      if (lower > 0 && lower * lower > best) break;
+    }
+    const std::uint32_t k = triangles[c];
     const Vec3 q = t.closestOn(k, p);
     const double d2 = (q - p).squaredNorm();
-    if (d2 < best) {
+    // The nearest, the lowest index of a tie: closestPointWithin's rule.
+    if (d2 < best || (found && d2 == best && k < best_triangle)) {
       best = d2;
+      best_triangle = k;
       closest = q;
       found = true;
     }

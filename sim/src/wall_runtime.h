@@ -71,12 +71,13 @@ class WallRuntime {
 
   /// Whether x is nearer than `range` to the wall (planes: signed distance, so a
   /// point behind is near). A mesh wall also appends the triangles nearer than
-  /// `range` (increasing) to `triangles`: a ball's candidates until the next
-  /// neighbour build (contact()).
-  bool near(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& triangles) const {
+  /// `range` (nearest first) to `triangles` and their distances to `distances`: a
+  /// ball's candidates until the next neighbour build (contact()).
+  bool near(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& triangles,
+            std::vector<double>& distances) const {
     if (w.shape != WallShape::Mesh) return distance(w, x) < range;
     const std::size_t before = triangles.size();
-    mesh_index_.trianglesWithin(toBody(x), range, triangles);
+    mesh_index_.trianglesWithin(toBody(x), range, triangles, &distances);
     return triangles.size() > before;
   }
 
@@ -84,8 +85,10 @@ class WallRuntime {
   /// mesh wall looks only at `triangles`, the ball's candidates of the last
   /// neighbour build (near() with r + skin): the same contact as a search
   /// of the whole mesh while the ball and the wall have moved less than the skin.
+  /// With `distances` (near()'s) and how far the ball has moved since
+  /// (`ball_moved`, m) it stops at the first candidate that cannot be the nearest.
   bool contact(const Wall& w, const Vec3& x, double r, std::span<const std::uint32_t> triangles,
-               WallContact& out) const {
+               WallContact& out, std::span<const double> distances = {}, double ball_moved = 0) const {
     const Vec3 xb = toBody(x);
     if (w.shape == WallShape::Plane) {
       // One-sided: a ball behind the plane is still pushed out along its normal.
@@ -97,7 +100,9 @@ class WallRuntime {
     }
     Vec3 q;
     if (w.shape == WallShape::Mesh) {
-      if (!mesh_index_.closestPointAmong(xb, r, triangles, q)) return false;
+      if (!mesh_index_.closestPointAmong(xb, r, triangles, q,
+                                         {distances, ball_moved + displacementSinceReference()}))
+        return false;
     } else {
       q = closestInBody(w, xb);
     }

@@ -95,12 +95,15 @@ struct ContactPoint {
 }
 
 /// A ball against an active wall; false when apart or the wall is not there.
-/// `triangles`: a mesh wall's candidate triangles for this ball (NeighbourLists).
+/// `triangles`: a mesh wall's candidate triangles for this ball (NeighbourLists);
+/// with their `distances` at the build and how far the ball moved since
+/// (`ball_moved`, m) fewer of them are tested (WallRuntime::contact).
 [[gnu::always_inline]] inline bool ballWallTouch(const detail::WallRuntime& runtime, const Wall& wall,
                                                  const Vec3& xi, double ri, std::span<const std::uint32_t> triangles,
-                                                 ContactPoint& g) {
+                                                 ContactPoint& g, std::span<const double> distances = {},
+                                                 double ball_moved = 0) {
   detail::WallContact wc;
-  if (!runtime.active || !runtime.contact(wall, xi, ri, triangles, wc)) return false;
+  if (!runtime.active || !runtime.contact(wall, xi, ri, triangles, wc, distances, ball_moved)) return false;
   g.normal = wc.normal;
   g.overlap = wc.overlap;
   g.point = xi + g.normal * (ri - 0.5 * g.overlap);
@@ -180,10 +183,15 @@ struct World::Impl {
     // Mesh walls: candidate k's triangles within r + skin at the build are
     // wall_triangles[wall_triangle_offset[k] .. [k+1]] (empty for other walls).
     std::vector<std::uint32_t> wall_triangle_offset;  // [k+1]
-    std::vector<std::uint32_t> wall_triangles;
+    std::vector<std::uint32_t> wall_triangles;  // nearest first
+    std::vector<double> wall_triangle_distance;  // m, from the ball at the build
     std::span<const std::uint32_t> trianglesOf(std::uint32_t candidate) const {
       return {wall_triangles.data() + wall_triangle_offset[candidate],
               wall_triangles.data() + wall_triangle_offset[candidate + 1]};
+    }
+    std::span<const double> triangleDistancesOf(std::uint32_t candidate) const {
+      return {wall_triangle_distance.data() + wall_triangle_offset[candidate],
+              wall_triangle_distance.data() + wall_triangle_offset[candidate + 1]};
     }
     std::vector<Vec3> ref_position;          // [n] m, positions at the last rebuild
     double skin = 0.0;                       // m

@@ -57,11 +57,23 @@ TEST_CASE("closest points through the AABB tree equal the brute force", "[geomet
       const double skin = 0.004;
       const Vec3 before = p + 0.9 * skin * Vec3(u.x() - 0.5, u.z() - 0.5, u.y() - 0.5).normalized();
       std::vector<std::uint32_t> candidates;
-      index.trianglesWithin(before, radius + skin, candidates);
-      CHECK(std::is_sorted(candidates.begin(), candidates.end()));
+      std::vector<double> distances;
+      index.trianglesWithin(before, radius + skin, candidates, &distances);
+      REQUIRE(distances.size() == candidates.size());
+      CHECK(std::is_sorted(distances.begin(), distances.end()));  // nearest first
       Vec3 among = Vec3::Zero();
       CHECK(index.closestPointAmong(p, radius, candidates, among) == within);
       if (within) CHECK(among == near);
+      // Told where the candidates were found and how far the point moved since, it
+      // stops early and still finds that point bit for bit, in any order of the
+      // candidates without the bounds.
+      Vec3 bounded = Vec3::Zero();
+      CHECK(index.closestPointAmong(p, radius, candidates, bounded, {distances, (p - before).norm()}) == within);
+      if (within) CHECK(bounded == near);
+      std::vector<std::uint32_t> reversed(candidates.rbegin(), candidates.rend());
+      Vec3 any_order = Vec3::Zero();
+      CHECK(index.closestPointAmong(p, radius, reversed, any_order) == within);
+      if (within) CHECK(any_order == near);
     }
     INFO("triangles " << mesh.triangleCount());
     CHECK(worst < 1e-12);

@@ -208,7 +208,8 @@ TEST_CASE("a spinning faceted frustum wall: the contact velocity has no spin nor
     const Vec3 centre = Vec3(0, 0, 0.05) + (0.1 + 0.7 * r) * radial;
     sim::detail::WallContact touch;
     std::vector<std::uint32_t> triangles;
-    REQUIRE(runtime.near(mantle, centre, r, triangles));
+    std::vector<double> distances;
+    REQUIRE(runtime.near(mantle, centre, r, triangles, distances));
     REQUIRE(runtime.contact(mantle, centre, r, triangles, touch));
     const Vec3 n = touch.normal;
     const Vec3 point = centre + (r - touch.overlap) * n;

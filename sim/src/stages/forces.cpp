@@ -69,11 +69,14 @@ template <class Law>
 inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c) {
   const Vec3 xi = p.position[i];
   const double ri = p.radius[i];
+  double moved = -1;  // m since the neighbour build: only for a mesh wall's candidates
   for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
     const std::uint32_t wk = nb.wall_index[w];
     const detail::WallRuntime& wr = walls[wk];
     ContactPoint touch;
-    if (!ballWallTouch(wr, model.walls[wk], xi, ri, nb.trianglesOf(w), touch)) {
+    const std::span<const std::uint32_t> triangles = nb.trianglesOf(w);
+    if (!triangles.empty() && moved < 0) moved = (xi - nb.ref_position[i]).norm();
+    if (!ballWallTouch(wr, model.walls[wk], xi, ri, triangles, touch, nb.triangleDistancesOf(w), moved)) {
       history.wall_touch[w] = 0;
       history.wall_shear[w].setZero();
       if (relax.active()) relax.wall[w] = 0.0;

@@ -56,10 +56,13 @@ void World::Impl::rebuildNeighbours() {
   nb.wall_index.clear();
   nb.wall_triangle_offset.assign(1, 0);
   nb.wall_triangles.clear();
+  nb.wall_triangle_distance.clear();
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t k = 0; k < walls.size(); ++k) {
       if (!walls[k].active) continue;
-      if (!walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles)) continue;
+      if (!walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles,
+                         nb.wall_triangle_distance))
+        continue;
       nb.wall_index.push_back(static_cast<std::uint32_t>(k));
       nb.wall_triangle_offset.push_back(static_cast<std::uint32_t>(nb.wall_triangles.size()));
     }

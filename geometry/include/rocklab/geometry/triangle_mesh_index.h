@@ -18,6 +18,15 @@
 
 namespace rocklab::geometry {
 
+/// Where a ball's candidate triangles were found (TriangleMeshIndex::trianglesWithin):
+/// the distance of each from the point then, nearest first, and how far the point
+/// and the mesh have moved since, at most (m). No triangle can now be nearer than
+/// its distance then less `moved`.
+struct CandidateDistances {
+  std::span<const double> then;
+  double moved = 0;
+};
+
 class TriangleMeshIndex {
  public:
   TriangleMeshIndex() = default;  // no mesh: closestPoint must not be called
@@ -35,15 +44,20 @@ class TriangleMeshIndex {
   /// ball's contact costs a few triangles whatever the mesh.
   bool closestPointWithin(const Vec3& p, double radius, Vec3& closest) const;
 
-  /// Appends to `out`, in increasing order, every triangle nearer to p than
-  /// `radius`: the candidates of a ball for as long as it and the mesh move less
-  /// than the margin `radius` holds beyond the ball (a neighbour list's skin).
-  void trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const;
-  /// closestPointWithin over the given triangles only (increasing indices): the
-  /// same point, when they hold every triangle nearer to p than `radius`, at the
-  /// cost of a few closest-point tests instead of a tree query.
-  bool closestPointAmong(const Vec3& p, double radius, std::span<const std::uint32_t> triangles,
-                         Vec3& closest) const;
+  /// Appends to `out` every triangle nearer to p than `radius`, nearest first
+  /// (ties by index), and to `distances` (when given) each one's distance from p:
+  /// the candidates of a ball for as long as it and the mesh move less than the
+  /// margin `radius` holds beyond the ball (a neighbour list's skin).
+  void trianglesWithin(const Vec3& p, double radius, std::vector<std::uint32_t>& out,
+                       std::vector<double>* distances = nullptr) const;
+  /// closestPointWithin over the given triangles only: the same point (the
+  /// nearest triangle, the lowest index on a tie, in whatever order they come),
+  /// when they hold every triangle nearer to p than `radius`, at the cost of a few
+  /// closest-point tests instead of a tree query. With `bounds` (the triangles in
+  /// trianglesWithin's order) the search stops at the first triangle that cannot
+  /// come as near as the best so far: the same point, fewer tests.
+  bool closestPointAmong(const Vec3& p, double radius, std::span<const std::uint32_t> triangles, Vec3& closest,
+                         const CandidateDistances& bounds = {}) const;
 
   /// A point where a ball centred at p touches the surface.
   struct Touch {
