@@ -2,12 +2,14 @@
 // Runs the CLI in-process, as `rocklab ARGS...` would: returns the exit code.
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "rocklab/experiments/cli.h"
@@ -40,6 +42,17 @@ inline std::filesystem::path scratchDir(const std::string& name) {
 }
 
 /// A whole file's bytes ("" when it cannot be read).
+/// Waits (up to a minute) until the run writing into `out` has opened its
+/// run.h5.partial, which it does after its stop handlers are in place: a signal
+/// sent then stops the run, where one sent while it still loads its scene would
+/// meet the default action (a fixed delay lost that race on a loaded machine).
+inline void waitUntilRunning(const std::filesystem::path& out) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!std::filesystem::exists(out / "run.h5.partial") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // its first steps (frame 0) done
+}
+
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), {}};

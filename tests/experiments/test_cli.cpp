@@ -21,6 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 using rocklab::experiments::test::cli;
 using rocklab::experiments::test::slurp;
+using rocklab::experiments::test::waitUntilRunning;
 fs::path tempDir(const std::string& name) {
   // The pid keeps two checkouts' suites running at once apart.
   const fs::path d = fs::temp_directory_path() / ("rocklab-cli-" + name + "-" + std::to_string(::getpid()));
@@ -153,8 +154,8 @@ TEST_CASE("check prints the step the run takes with the bonds' springs", "[cli]"
 
 TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and results", "[cli]") {
   const fs::path out = tempDir("sigint");
-  std::thread interrupter([] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  std::thread interrupter([&out] {
+    waitUntilRunning(out);
     std::raise(SIGINT);  // the handler runCli installed turns it into a clean stop
   });
   const int code = cli({"run", kScene, "--out", out.string(), "--quiet", "--set", "scene.end_time=100"});
@@ -194,8 +195,8 @@ TEST_CASE("a second Ctrl-C ends the process at once", "[cli]") {
   const pid_t child = ::fork();
   REQUIRE(child >= 0);
   if (child == 0) {
-    std::thread interrupter([] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    std::thread interrupter([&out] {
+      waitUntilRunning(out);
       std::raise(SIGINT);  // clean stop requested
       std::raise(SIGINT);  // the second kills
     });

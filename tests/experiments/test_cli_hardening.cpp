@@ -23,6 +23,7 @@ using Catch::Contains;
 using nlohmann::json;
 using rocklab::experiments::test::cli;
 using rocklab::experiments::test::slurp;
+using rocklab::experiments::test::waitUntilRunning;
 
 namespace {
 
@@ -217,8 +218,8 @@ TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C and a second signal kills",
     const fs::path out = tempDir("signal" + std::to_string(signal));
     const auto before = std::signal(signal, SIG_DFL);  // the test runner's own handler
     std::signal(signal, before);
-    std::thread sender([signal] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    std::thread sender([signal, &out] {
+      waitUntilRunning(out);
       std::raise(signal);  // what Slurm sends at its time limit, or a closed terminal
     });
     const int code = cli({"run", kHopper, "--out", out.string(), "--quiet", "--set", "scene.end_time=100"});
@@ -236,8 +237,8 @@ TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C and a second signal kills",
     const pid_t child = ::fork();
     REQUIRE(child >= 0);
     if (child == 0) {
-      std::thread twice([signal] {
-        std::this_thread::sleep_for(std::chrono::milliseconds(700));
+      std::thread twice([signal, &out2] {
+        waitUntilRunning(out2);
         std::raise(signal);
         std::raise(signal);
       });
