@@ -909,6 +909,15 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
     const auto& b = c["breakage"];
     CHECK(b["events"].get<int>() >= 1);
     CHECK(b["fragments_created"] == 3 * b["events"].get<int>());
+    // The breakage's cost is part of the stepping's wall time: checks and freezes.
+    const auto& w = r["wall_time_s"];
+    CHECK(w["breakage_checks"].get<double>() > 0);
+    CHECK(w["breakage_freezes"].get<double>() > 0);
+    CHECK(w["breakage_checks"].get<double>() + w["breakage_freezes"].get<double>() < w["stepping"].get<double>());
+    // The particle count: six fed, each breakage adds two (three fragments for a ball).
+    CHECK(c["balls_max"].get<int>() >= 6);
+    CHECK(c["balls_max"].get<int>() <= 6 + 2 * b["events"].get<int>());
+    CHECK(fs::exists(out / "ball_count.png"));
     if (threads == 1) {
       CHECK(c["discharged_balls"] == 6 + 2 * b["events"].get<int>());
       CHECK(c["empty"] == true);

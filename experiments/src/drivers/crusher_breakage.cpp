@@ -1,6 +1,7 @@
 #include "drivers/crusher_breakage.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -288,6 +289,15 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   if (world->stepCount() % every_ != 0) return false;
   const sim::ParticleState& p = world->particles();
   if (p.size() == 0) return false;
+  // Everything from here is the check's cost but the freeze (freeze_seconds_).
+  const auto started = std::chrono::steady_clock::now();
+  double frozen = 0;  // s in the freeze
+  struct AddTime {
+    double& total;
+    const std::chrono::steady_clock::time_point& start;
+    const double& less;
+    ~AddTime() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - less; }
+  } add_time{check_seconds_, started, frozen};
   struct Broken {
     std::uint32_t row;
     double q, strength;
@@ -358,8 +368,11 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
     events_.push_back(std::move(e));
   }
   loaded.resize(state.particles.size(), false);  // the fragments
+  const auto freeze_start = std::chrono::steady_clock::now();
   const crusher::FreezeResult freeze =
       crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads, loaded);
+  frozen = std::chrono::duration<double>(std::chrono::steady_clock::now() - freeze_start).count();
+  freeze_seconds_ += frozen;
   // What the freeze hands back: the run's World on the state after it (built here
   // when the positions came back; it is the run's next World if the breakage is
   // kept), and the elastic energy of the moved balls' contacts in it, at the run's

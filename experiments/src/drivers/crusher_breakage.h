@@ -122,6 +122,11 @@ class CrusherBreakage {
   /// report is written only at the end of a run).
   std::string progress() const;
   std::size_t fragmentsCreated() const { return fragments_created_; }
+  /// Wall time (s) this run spent in the checks (stresses, strengths, splits and
+  /// the World rebuilt after a breakage) and in the freezes: the breakage's cost
+  /// beside the whole stepping. Not saved for a restart (like wall_time_s).
+  double checkSeconds() const { return check_seconds_; }
+  double freezeSeconds() const { return freeze_seconds_; }
   /// results.json's crusher.breakage (without the mass balance, which the driver
   /// adds) and breakage.csv.
   nlohmann::json report(const std::vector<double>& sieves_mm, const std::filesystem::path& out_dir) const;
@@ -175,6 +180,7 @@ class CrusherBreakage {
   std::map<std::uint64_t, double> deferred_until_;  // id -> time before which it does not break
   std::size_t fragments_created_ = 0;
   bool interrupted_ = false;
+  double check_seconds_ = 0, freeze_seconds_ = 0;
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
   std::uint64_t freezes_stalled_ = 0, freezes_crowded_ = 0;  // crowded: kept with freeze_crowded "break"
   double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left

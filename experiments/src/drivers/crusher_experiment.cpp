@@ -90,6 +90,7 @@ class CrusherRunExperiment final : public Experiment {
     if (breakage_.interrupted()) return true;
     if (world->stepCount() % every_ != 0) return true;
     meterPower(*world);
+    ball_count_.emplace_back(world->time(), static_cast<double>(world->particles().size()));
     if (bonded_) {
       const auto& intact = world->bonds().intact;
       bonds_intact_ = static_cast<std::size_t>(std::count(intact.begin(), intact.end(), std::uint8_t{1}));
@@ -240,6 +241,7 @@ class CrusherRunExperiment final : public Experiment {
     j["bonded"] = bonded_;
     j["porosity"] = porosity_;
     j["fragment_balls"] = fragment_balls_;
+    j["ball_count"] = ball_count_;
     j["strengthened"] = strengthened_;
     j["restored_at"] = restored_at_;  // NaN until the strengths are restored: CBOR keeps it
     j["tensile"] = tensile_;
@@ -270,6 +272,7 @@ class CrusherRunExperiment final : public Experiment {
     j.at("bonded").get_to(bonded_);
     j.at("porosity").get_to(porosity_);
     j.at("fragment_balls").get_to(fragment_balls_);
+    j.at("ball_count").get_to(ball_count_);
     j.at("strengthened").get_to(strengthened_);
     j.at("restored_at").get_to(restored_at_);
     j.at("tensile").get_to(tensile_);
@@ -358,7 +361,17 @@ class CrusherRunExperiment final : public Experiment {
                     "of the product finer than each sieve size";
     }
     c["whiten"] = whiten_report;
-    writePowerPlot(out_dir, log);
+    writeSeriesPlot("Mantle power (work of the moving walls on the balls)", "power (W)", "mantle and cap",
+                    power_.series(), out_dir / "mantle_power.png", log);
+    // The particle count over the run: breakage adds balls, discharge removes them.
+    writeSeriesPlot("Balls in the run (feed, fragments; discharged ones leave)", "balls", "balls", ball_count_,
+                    out_dir / "ball_count.png", log);
+    if (!ball_count_.empty()) {
+      const auto most = std::max_element(ball_count_.begin(), ball_count_.end(),
+                                         [](const auto& a, const auto& b) { return a.second < b.second; });
+      c["balls_max"] = static_cast<std::size_t>(most->second);
+      c["balls_max_time_s"] = most->first;
+    }
     if (e_.breakage.enabled) {
       nlohmann::json b = breakage_.report(e_.sieves_mm, out_dir);
       // Breakage conserves mass to round-off: the feed is the product and what is left.
@@ -369,6 +382,11 @@ class CrusherRunExperiment final : public Experiment {
       c["breakage"] = b;
     }
     r["crusher"] = c;
+    if (e_.breakage.enabled) {
+      // The breakage's cost beside the whole stepping (this run's, as wall_time_s).
+      r["wall_time_s"]["breakage_checks"] = breakage_.checkSeconds();
+      r["wall_time_s"]["breakage_freezes"] = breakage_.freezeSeconds();
+    }
     log << "crusher: " << product_.size() << (bonded_ ? " fragments" : " balls") << " discharged (" << product_mass
         << " kg of " << feed_mass << " kg fed)";
     if (e_.breakage.enabled)
@@ -393,6 +411,7 @@ class CrusherRunExperiment final : public Experiment {
   bool bonded_ = false;                            // the world has bonds: discharge by fragments
   std::unordered_map<std::uint64_t, double> porosity_;  // ball id -> its agglomerate's porosity
   std::vector<std::size_t> fragment_balls_;        // balls of each discharged fragment
+  std::vector<std::pair<double, double>> ball_count_;  // (s, balls in the run) every sample_interval
   double release_time_ = std::numeric_limits<double>::infinity();  // s, the stop wall goes
   bool strengthened_ = false;
   double restored_at_ = std::numeric_limits<double>::quiet_NaN();
@@ -444,23 +463,26 @@ class CrusherRunExperiment final : public Experiment {
     metered_time_ = world.time();
   }
 
-  /// mantle_power.png: the moving walls' power, averaged over each sample_interval.
-  void writePowerPlot(const std::filesystem::path& out_dir, std::ostream& log) const {
-    if (power_.series().empty()) return;
+  /// A (time s, value) series against time, every sample_interval: mantle_power.png
+  /// (the moving walls' power averaged over each interval), ball_count.png.
+  static void writeSeriesPlot(const std::string& title, const std::string& y_label, const std::string& name,
+                              const std::vector<std::pair<double, double>>& points, const std::filesystem::path& file,
+                              std::ostream& log) {
+    if (points.empty()) return;
     PlotSpec spec;
-    spec.title = "Mantle power (work of the moving walls on the balls)";
+    spec.title = title;
     spec.x_label = "time (s)";
-    spec.y_label = "power (W)";
-    PlotSeries series{"mantle and cap", {}, {}, PlotSeries::Style::Line};
-    for (const auto& [t, w] : power_.series()) {
+    spec.y_label = y_label;
+    PlotSeries series{name, {}, {}, PlotSeries::Style::Line};
+    for (const auto& [t, v] : points) {
       series.x.push_back(t);
-      series.y.push_back(w);
+      series.y.push_back(v);
     }
     spec.series = {series};
     try {
-      writePlot(spec, out_dir / "mantle_power.png");
+      writePlot(spec, file);
     } catch (const std::exception& e) {
-      log << "crusher: no power plot (" << e.what() << ")\n";
+      log << "crusher: no plot " << file.filename().string() << " (" << e.what() << ")\n";
     }
   }
 
