@@ -146,53 +146,15 @@ sim::Material CrusherBreakage::classMaterial(const sim::Material& feed, int feed
 
 nlohmann::json CrusherBreakage::saveState() const {
   nlohmann::json j;
-  j["check_interval"] = check_interval_;
-  j["every"] = every_;
-  j["next_id"] = next_id_;
-  j["class_material"] = class_material_;
-  j["events"] = events_;
+  savedFields(*this, [&j](const char* key, const auto& value) { j[key] = value; });
   j["jump_watch"] = jump_watch_ ? nlohmann::json(*jump_watch_) : nlohmann::json(nullptr);
-  j["deferrals"] = deferrals_;
-  j["deferred_until"] = deferred_until_;
-  j["fragments_created"] = fragments_created_;
-  j["freezes"] = freezes_;
-  j["freeze_cycles"] = freeze_cycles_;
-  j["max_freeze_cycles"] = max_freeze_cycles_;
-  j["freezes_stalled"] = freezes_stalled_;
-  j["freezes_crowded"] = freezes_crowded_;
-  j["max_freeze_balls"] = max_freeze_balls_;
-  j["reach_widenings"] = reach_widenings_;
-  j["moved_neighbours"] = moved_neighbours_;
-  j["max_freeze_overlap"] = max_freeze_overlap_;
-  j["max_crowded_overlap"] = max_crowded_overlap_;
-  j["max_crowded_handed_back"] = max_crowded_handed_back_;
-  j["max_excess"] = max_excess_;  // -inf before the first kept freeze: CBOR keeps it
   return j;
 }
 
 void CrusherBreakage::restoreState(const nlohmann::json& j, sim::Model& model) {
-  j.at("check_interval").get_to(check_interval_);
-  j.at("every").get_to(every_);
-  j.at("next_id").get_to(next_id_);
-  j.at("class_material").get_to(class_material_);
-  j.at("events").get_to(events_);
+  savedFields(*this, [&j](const char* key, auto& value) { j.at(key).get_to(value); });
   jump_watch_.reset();
   if (!j.at("jump_watch").is_null()) jump_watch_ = j.at("jump_watch").get<JumpWatch>();
-  j.at("deferrals").get_to(deferrals_);
-  j.at("deferred_until").get_to(deferred_until_);
-  j.at("fragments_created").get_to(fragments_created_);
-  j.at("freezes").get_to(freezes_);
-  j.at("freeze_cycles").get_to(freeze_cycles_);
-  j.at("max_freeze_cycles").get_to(max_freeze_cycles_);
-  j.at("freezes_stalled").get_to(freezes_stalled_);
-  j.at("freezes_crowded").get_to(freezes_crowded_);
-  j.at("max_freeze_balls").get_to(max_freeze_balls_);
-  j.at("reach_widenings").get_to(reach_widenings_);
-  j.at("moved_neighbours").get_to(moved_neighbours_);
-  j.at("max_freeze_overlap").get_to(max_freeze_overlap_);
-  j.at("max_crowded_overlap").get_to(max_crowded_overlap_);
-  j.at("max_crowded_handed_back").get_to(max_crowded_handed_back_);
-  j.at("max_excess").get_to(max_excess_);
   if (every_ == 0) throw std::invalid_argument("breakage check every 0 steps (allowed: at least 1)");
   // The fragment materials in the order the run added them after the scene's.
   std::vector<std::pair<int, std::pair<int, int>>> added;  // (material, (feed material, class))

@@ -181,6 +181,32 @@ class CrusherBreakage {
   std::size_t fragments_created_ = 0;
   bool interrupted_ = false;
   double check_seconds_ = 0, freeze_seconds_ = 0;
+
+  /// What saveState writes and restoreState reads (but jump_watch_): each member
+  /// once, as f(key, member), for a const or a mutable self.
+  template <class Self, class F>
+  static void savedFields(Self& self, F&& f) {
+    f("check_interval", self.check_interval_);
+    f("every", self.every_);
+    f("next_id", self.next_id_);
+    f("class_material", self.class_material_);
+    f("events", self.events_);
+    f("deferrals", self.deferrals_);
+    f("deferred_until", self.deferred_until_);
+    f("fragments_created", self.fragments_created_);
+    f("freezes", self.freezes_);
+    f("freeze_cycles", self.freeze_cycles_);
+    f("max_freeze_cycles", self.max_freeze_cycles_);
+    f("freezes_stalled", self.freezes_stalled_);
+    f("freezes_crowded", self.freezes_crowded_);
+    f("max_freeze_balls", self.max_freeze_balls_);
+    f("reach_widenings", self.reach_widenings_);
+    f("moved_neighbours", self.moved_neighbours_);
+    f("max_freeze_overlap", self.max_freeze_overlap_);
+    f("max_crowded_overlap", self.max_crowded_overlap_);
+    f("max_crowded_handed_back", self.max_crowded_handed_back_);
+    f("max_excess", self.max_excess_);  // -inf before the first kept freeze: CBOR keeps it
+  }
   std::uint64_t freezes_ = 0, freeze_cycles_ = 0, max_freeze_cycles_ = 0;
   std::uint64_t freezes_stalled_ = 0, freezes_crowded_ = 0;  // crowded: kept with freeze_crowded "break"
   double max_freeze_overlap_ = 0;         // the largest overlap fraction a freeze left

@@ -227,59 +227,19 @@ class CrusherRunExperiment final : public Experiment {
 
   nlohmann::json saveState() const override {
     nlohmann::json j;
-    j["started"] = started_;
-    j["every"] = every_;
-    j["chamber_mass"] = chamber_mass_;
-    j["product"] = product_;
-    j["feed"] = feed_;
+    savedFields(*this, [&j](const char* key, const auto& value) { j[key] = value; });
     j["breakage"] = e_.breakage.enabled ? breakage_.saveState() : nlohmann::json(nullptr);
-    j["entries"] = entries_;
-    j["power"] = power_;
-    j["metered_work"] = metered_work_;
-    j["metered_time"] = metered_time_;
-    j["events_seen"] = events_seen_;
-    j["bonded"] = bonded_;
-    j["porosity"] = porosity_;
-    j["fragment_balls"] = fragment_balls_;
-    j["ball_count"] = ball_count_;
-    j["strengthened"] = strengthened_;
-    j["restored_at"] = restored_at_;  // NaN until the strengths are restored: CBOR keeps it
-    j["tensile"] = tensile_;
-    j["shear"] = shear_;
-    j["bonds_at_start"] = bonds_at_start_;
-    j["bonds_intact"] = bonds_intact_;
-    j["intact_at_release"] = intact_at_release_;
     return j;
   }
 
   void restoreState(const nlohmann::json& j, sim::Model& model) override {
-    j.at("started").get_to(started_);
-    j.at("every").get_to(every_);
-    j.at("chamber_mass").get_to(chamber_mass_);
-    j.at("product").get_to(product_);
-    j.at("feed").get_to(feed_);
+    savedFields(*this, [&j](const char* key, auto& value) { j.at(key).get_to(value); });
     if (const nlohmann::json& b = j.at("breakage"); b.is_null() == e_.breakage.enabled)
       throw std::invalid_argument(std::string("the run was saved ") + (b.is_null() ? "without" : "with") +
                                   " [experiment.breakage] and the scene now has " +
                                   (e_.breakage.enabled ? "it" : "none") + ": restart with the table as it was");
     else if (e_.breakage.enabled)
       breakage_.restoreState(b, model);
-    j.at("entries").get_to(entries_);
-    j.at("power").get_to(power_);
-    j.at("metered_work").get_to(metered_work_);
-    j.at("metered_time").get_to(metered_time_);
-    j.at("events_seen").get_to(events_seen_);
-    j.at("bonded").get_to(bonded_);
-    j.at("porosity").get_to(porosity_);
-    j.at("fragment_balls").get_to(fragment_balls_);
-    j.at("ball_count").get_to(ball_count_);
-    j.at("strengthened").get_to(strengthened_);
-    j.at("restored_at").get_to(restored_at_);
-    j.at("tensile").get_to(tensile_);
-    j.at("shear").get_to(shear_);
-    j.at("bonds_at_start").get_to(bonds_at_start_);
-    j.at("bonds_intact").get_to(bonds_intact_);
-    j.at("intact_at_release").get_to(intact_at_release_);
     if (every_ == 0) throw std::invalid_argument("sample every 0 steps (allowed: at least 1)");
   }
 
@@ -418,6 +378,33 @@ class CrusherRunExperiment final : public Experiment {
   std::vector<double> tensile_, shear_;  // the strengths before settle_bond_factor
   std::size_t bonds_at_start_ = 0, bonds_intact_ = 0;
   double intact_at_release_ = std::numeric_limits<double>::quiet_NaN();
+
+  /// What saveState writes and restoreState reads (but the breakage's own): each
+  /// member once, as f(key, member), for a const or a mutable self.
+  template <class Self, class F>
+  static void savedFields(Self& self, F&& f) {
+    f("started", self.started_);
+    f("every", self.every_);
+    f("chamber_mass", self.chamber_mass_);
+    f("product", self.product_);
+    f("feed", self.feed_);
+    f("entries", self.entries_);
+    f("power", self.power_);
+    f("metered_work", self.metered_work_);
+    f("metered_time", self.metered_time_);
+    f("events_seen", self.events_seen_);
+    f("bonded", self.bonded_);
+    f("porosity", self.porosity_);
+    f("fragment_balls", self.fragment_balls_);
+    f("ball_count", self.ball_count_);
+    f("strengthened", self.strengthened_);
+    f("restored_at", self.restored_at_);  // NaN until the strengths are restored: CBOR keeps it
+    f("tensile", self.tensile_);
+    f("shear", self.shear_);
+    f("bonds_at_start", self.bonds_at_start_);
+    f("bonds_intact", self.bonds_intact_);
+    f("intact_at_release", self.intact_at_release_);
+  }
 
   static double massOf(const std::vector<ProductBall>& balls) {
     double m = 0;
