@@ -228,12 +228,16 @@ class CrusherRunExperiment final : public Experiment {
   nlohmann::json saveState() const override {
     nlohmann::json j;
     savedFields(*this, [&j](const char* key, const auto& value) { j[key] = value; });
+    j["ball_count"] = ball_count_;
     j["breakage"] = e_.breakage.enabled ? breakage_.saveState() : nlohmann::json(nullptr);
     return j;
   }
 
   void restoreState(const nlohmann::json& j, sim::Model& model) override {
     savedFields(*this, [&j](const char* key, auto& value) { j.at(key).get_to(value); });
+    // Not in the checkpoints of 3242d50 and e87d732: their series starts at the restart.
+    ball_count_.clear();
+    if (j.contains("ball_count")) j.at("ball_count").get_to(ball_count_);
     if (const nlohmann::json& b = j.at("breakage"); b.is_null() == e_.breakage.enabled)
       throw std::invalid_argument(std::string("the run was saved ") + (b.is_null() ? "without" : "with") +
                                   " [experiment.breakage] and the scene now has " +
@@ -379,7 +383,8 @@ class CrusherRunExperiment final : public Experiment {
   std::size_t bonds_at_start_ = 0, bonds_intact_ = 0;
   double intact_at_release_ = std::numeric_limits<double>::quiet_NaN();
 
-  /// What saveState writes and restoreState reads (but the breakage's own): each
+  /// What saveState writes and restoreState reads (but the breakage's own and the
+  /// ball count): each
   /// member once, as f(key, member), for a const or a mutable self.
   template <class Self, class F>
   static void savedFields(Self& self, F&& f) {
@@ -396,7 +401,6 @@ class CrusherRunExperiment final : public Experiment {
     f("bonded", self.bonded_);
     f("porosity", self.porosity_);
     f("fragment_balls", self.fragment_balls_);
-    f("ball_count", self.ball_count_);
     f("strengthened", self.strengthened_);
     f("restored_at", self.restored_at_);  // NaN until the strengths are restored: CBOR keeps it
     f("tensile", self.tensile_);
