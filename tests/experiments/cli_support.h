@@ -41,7 +41,6 @@ inline std::filesystem::path scratchDir(const std::string& name) {
   return d;
 }
 
-/// A whole file's bytes ("" when it cannot be read).
 /// Waits (up to a minute) until the run writing into `out` has opened its
 /// run.h5.partial, which it does after its stop handlers are in place: a signal
 /// sent then stops the run, where one sent while it still loads its scene would
@@ -53,6 +52,7 @@ inline void waitUntilRunning(const std::filesystem::path& out) {
   std::this_thread::sleep_for(std::chrono::milliseconds(300));  // its first steps (frame 0) done
 }
 
+/// A whole file's bytes ("" when it cannot be read).
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), {}};

@@ -214,15 +214,8 @@ TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and say
   // machine: a run still starting was killed by the default action, exit 143, with no
   // results.json.)
   std::thread sender([&dir] {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    const auto started = [&dir] {
-      for (const char* run : {"contact.damping_normal=0.1", "contact.damping_normal=0.2"})
-        if (!fs::exists(dir / "runs" / run / "run.h5.partial")) return false;
-      return true;
-    };
-    while (!started() && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    for (const char* run : {"contact.damping_normal=0.1", "contact.damping_normal=0.2"})
+      rocklab::experiments::test::waitUntilRunning(dir / "runs" / run);
     std::raise(SIGTERM);
   });
   const auto t0 = std::chrono::steady_clock::now();

@@ -248,18 +248,18 @@ void CrusherBreakage::watchKineticJump(const sim::World& world) {
 bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
   interrupted_ = false;
   watchKineticJump(*world);
-  if (world->stepCount() % every_ != 0) return false;
-  const sim::ParticleState& p = world->particles();
-  if (p.size() == 0) return false;
-  // Everything from here is the check's cost but the freeze (freeze_seconds_).
+  if (world->stepCount() % every_ != 0 || world->particles().size() == 0) return false;
+  // The check's cost is its time but the freeze's (freeze_seconds_, timed inside).
   const auto started = std::chrono::steady_clock::now();
-  double frozen = 0;  // s in the freeze
-  struct AddTime {
-    double& total;
-    const std::chrono::steady_clock::time_point& start;
-    const double& less;
-    ~AddTime() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - less; }
-  } add_time{check_seconds_, started, frozen};
+  const double frozen_before = freeze_seconds_;
+  const bool changed = breakOverStrength(world, ctx);
+  check_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() -
+                    (freeze_seconds_ - frozen_before);
+  return changed;
+}
+
+bool CrusherBreakage::breakOverStrength(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
+  const sim::ParticleState& p = world->particles();
   struct Broken {
     std::uint32_t row;
     double q, strength;
@@ -333,8 +333,7 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   const auto freeze_start = std::chrono::steady_clock::now();
   const crusher::FreezeResult freeze =
       crusher::freezeFragments(model, state, rows, s_.freeze, ctx.threads, loaded);
-  frozen = std::chrono::duration<double>(std::chrono::steady_clock::now() - freeze_start).count();
-  freeze_seconds_ += frozen;
+  freeze_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - freeze_start).count();
   // What the freeze hands back: the run's World on the state after it (built here
   // when the positions came back; it is the run's next World if the breakage is
   // kept), and the elastic energy of the moved balls' contacts in it, at the run's

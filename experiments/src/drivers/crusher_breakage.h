@@ -157,6 +157,9 @@ class CrusherBreakage {
   std::map<int, int> base_of_;                    // fragment material -> the feed material it copies
   std::map<std::pair<int, int>, int> class_material_;  // (feed material, class) -> material
   std::vector<BreakageEvent> events_;
+  /// check() once it is due: breaks the balls over their strength, freezes their
+  /// fragments and rebuilds the world; whether it changed.
+  bool breakOverStrength(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx);
   /// The copy of `feed` that fragments of `size_class` get (fragmentMaterial).
   sim::Material classMaterial(const sim::Material& feed, int feed_index, int size_class) const;
   /// Follows the run's kinetic energy after a check that broke balls (BreakageEvent::kinetic_jump).
