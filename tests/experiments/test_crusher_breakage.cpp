@@ -135,7 +135,8 @@ sim::Energy energyAfterStep(std::unique_ptr<sim::World>& world) {
 
 }  // namespace
 
-TEST_CASE("the fragments' overlaps found through a grid equal those of every ball against every fragment, bit for bit",
+TEST_CASE("the fragments' overlaps found through a grid, and their largest through an x sweep, equal those of every ball "
+          "against every fragment, bit for bit",
           "[experiments][crusher]") {
   // A loose heap of 3,000 balls of 2-14 mm, a hundred of them fragments, many touching.
   sim::Model model;
@@ -173,6 +174,12 @@ TEST_CASE("the fragments' overlaps found through a grid equal those of every bal
   const crusher::FragmentOverlaps grid = crusher::fragmentOverlaps(model, p, fragments);
   CHECK(grid.max_fraction == all.max_fraction);
   CHECK(grid.energy == all.energy);
+  // The freeze's criteria read the largest through an x sweep: the same, bit for bit
+  // (twice: the buffers are kept).
+  crusher::LargestOverlap largest;
+  CHECK(largest(p, fragments) == all.max_fraction);
+  CHECK(largest(p, fragments) == all.max_fraction);
+  CHECK(largest(p, {}) == 0.0);
   CHECK(crusher::fragmentOverlaps(model, p, {}).energy == 0.0);
 }
 
@@ -647,6 +654,33 @@ TEST_CASE("the crowded cap in contact times ends a freeze that cannot part long 
   CHECK(capped.cycles < capped.cap_cycles + static_cast<std::uint64_t>(settings.check_cycles));
   CHECK(capped.cycles < static_cast<std::uint64_t>(settings.max_cycles) / 100);
   CHECK(capped.max_overlap > settings.stall_max_overlap);  // jammed, not slow
+  CHECK_FALSE(capped.jammed);  // the jam rule is off by default
+
+  // The jam rule ends it sooner: at rest, its overlap no longer falling, after its
+  // window of 20 contact times and well before the cap, at the overlap the cap
+  // would have left (the fragments have not moved since).
+  crusher::FreezeSettings jam = settings;
+  jam.jam_contact_times = 20;
+  tight = fragmentRow(2e-3, 1.25e-3);
+  const crusher::FreezeResult jammed = crusher::freezeFragments(tight.model, tight.state, fragments, jam, 1);
+  INFO("jammed: " << jammed.cycles << " cycles, window " << jammed.jam_window_cycles << ", overlap "
+                  << jammed.max_overlap);
+  CHECK(jammed.end == crusher::FreezeEnd::Crowded);
+  CHECK(jammed.jammed);
+  CHECK(jammed.jam_window_cycles == static_cast<std::uint64_t>(std::ceil(20 * contact_time / jammed.dt)));
+  CHECK(jammed.cycles >= jammed.jam_window_cycles);
+  CHECK(jammed.cycles < capped.cap_cycles / 2);
+  CHECK(jammed.max_overlap == Approx(capped.max_overlap).epsilon(0.01));
+  // A freeze that can part still does with the rule on: the free row converges in
+  // the same cycles as without it.
+  FreezeCase free = fragmentRow(2e-3, std::nullopt);
+  FreezeCase free_again = fragmentRow(2e-3, std::nullopt);
+  const crusher::FreezeResult parted = crusher::freezeFragments(free.model, free.state, fragments, jam, 1);
+  const crusher::FreezeResult parted_off =
+      crusher::freezeFragments(free_again.model, free_again.state, fragments, settings, 1);
+  CHECK(parted.end == crusher::FreezeEnd::Converged);
+  CHECK(parted.cycles == parted_off.cycles);
+  CHECK(free.state.particles.position == free_again.state.particles.position);
 
   // Without it the same freeze runs into freeze_max_cycles (here 3 times the cap).
   crusher::FreezeSettings cycles_only = settings;
@@ -895,7 +929,8 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
   std::string first_events;
   for (const int threads : {1, 2}) {
     const fs::path out = test::scratchDir("crusher-breakage-run-" + std::to_string(threads));
-    auto args = test::tinyCrusherRunArgs(out.string(), threads);
+    // The scene with the breakage on (its dt and minimum size overridden below).
+    auto args = test::tinyCrusherRunArgs(out.string(), threads, "cone-crusher-pbm-breakage.toml");
     for (const char* set : {"experiment.breakage.q_ref=2e5", "experiment.breakage.check_interval=2e-5",
                             "experiment.breakage.youngs_modulus=1e8", "experiment.breakage.min_diameter=0.0079",
                             "timestep.dt=7e-7", "output.vtk=false"})

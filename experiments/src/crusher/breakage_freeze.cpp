@@ -169,6 +169,32 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
   return o;
 }
 
+double LargestOverlap::operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers) {
+  by_x_.resize(p.size());
+  std::iota(by_x_.begin(), by_x_.end(), 0u);
+  std::sort(by_x_.begin(), by_x_.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return p.position[a].x() < p.position[b].x(); });
+  x_.resize(p.size());
+  for (std::size_t k = 0; k < by_x_.size(); ++k) x_[k] = p.position[by_x_[k]].x();
+  const double r_max = p.size() ? *std::max_element(p.radius.begin(), p.radius.end()) : 0.0;
+  double worst = 0;
+  for (const std::uint32_t f : movers) {
+    // A ball further in x than this cannot touch f: the margin keeps a pair that
+    // only round-off separates (norm >= |dx| up to an ulp) on the inside.
+    const double reach = (p.radius[f] + r_max) * (1 + 1e-9);
+    const double x = p.position[f].x();
+    for (auto k = static_cast<std::size_t>(std::lower_bound(x_.begin(), x_.end(), x - reach) - x_.begin());
+         k < x_.size() && x_[k] <= x + reach; ++k) {
+      const std::uint32_t j = by_x_[k];
+      if (j == f) continue;
+      // fragmentOverlaps' expression, so the largest is the same to the bit.
+      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+      if (overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
+    }
+  }
+  return worst;
+}
+
 namespace {
 
 /// One freeze of `frozen` (a copy of the run's balls, or of the local ones): the
@@ -211,12 +237,17 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
     result.cap_cycles = std::clamp<std::uint64_t>(
         static_cast<std::uint64_t>(std::ceil(s.max_contact_times * result.contact_time / result.dt)), 1,
         result.cap_cycles);
+  if (s.jam_contact_times > 0)
+    result.jam_window_cycles = std::max<std::uint64_t>(
+        1, static_cast<std::uint64_t>(std::ceil(s.jam_contact_times * result.contact_time / result.dt)));
   // At the fragments' own step ("local") the window is a few hundred cycles: the
   // criteria are looked at often enough to see it.
   std::uint64_t check = static_cast<std::uint64_t>(s.check_cycles);
   if (result.stall_window_cycles > 0)
     check = std::clamp<std::uint64_t>(result.stall_window_cycles / 4, 1, check);
   OverlapStall stall(result.stall_window_cycles, s.stall_tolerance);
+  OverlapStall jam(result.jam_window_cycles, s.stall_tolerance);
+  LargestOverlap largest_overlap;
   std::vector<bool> is_fragment(world.particles().size(), false);  // for the wall overlaps, every check
   for (const std::uint32_t f : fragments) is_fragment[f] = true;
   for (;;) {
@@ -231,18 +262,20 @@ FreezeResult runFreeze(const sim::Model& model, sim::WorldState frozen,
         ++result.cycles;
         continue;
       }
-      result.max_overlap = std::max(fragmentOverlaps(m, world.particles(), fragments).max_fraction,
-                                    wallOverlapFraction(world, is_fragment));
+      result.max_overlap =
+          std::max(largest_overlap(world.particles(), fragments), wallOverlapFraction(world, is_fragment));
       result.kinetic_energy = kineticEnergy(world.particles(), moving);
       const bool at_rest = result.kinetic_energy <= s.kinetic_fraction * result.artificial_energy;
       const bool stalled = stall.stalled(result.cycles, result.max_overlap);  // records the sample
+      const bool jammed = jam.stalled(result.cycles, result.max_overlap);     // likewise
       // The overlap criterion first: a freeze that can converge ends as converged.
       if (at_rest && result.max_overlap <= s.overlap_fraction) break;
       if (at_rest && stalled && result.max_overlap <= s.stall_max_overlap) {
         result.end = FreezeEnd::Stalled;
         break;
       }
-      if (result.cycles >= result.cap_cycles) {
+      result.jammed = at_rest && jammed && result.cycles < result.cap_cycles;
+      if (result.cycles >= result.cap_cycles || (result.jammed && s.crowded != CrowdedOutcome::Stop)) {
         if (s.crowded != CrowdedOutcome::Stop) {
           result.end = FreezeEnd::Crowded;
           if (s.crowded == CrowdedOutcome::Defer) return result;

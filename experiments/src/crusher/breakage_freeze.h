@@ -65,6 +65,14 @@
 //     since: on the nip every freeze parted in 1.3-6.9; in the 200-ball run the
 //     median was 7.4, 99 % within 86, 10 of 803 above 80: the slowest that part
 //     in the full chamber reach the cap, docs/crusher.md, seventh attempt.)
+//     A freeze is also crowded sooner ("jammed", jam_contact_times, off by
+//     default) when it is at rest, above the stall bound, and its largest overlap
+//     has not fallen by stall_tolerance over the last jam_contact_times contact
+//     times: fragments pinched among held neighbours settle where the soft springs
+//     balance and wait there for the cap (35 of the 36 million freeze cycles of the
+//     200-ball run were such freezes). The window must be longer than the slowest
+//     escape seen (the triple split's middle fragment leaving the line sideways
+//     after a plateau of 5-10 contact times, above).
 //     What follows is `crowded` (CrowdedOutcome): "break" hands the fragments
 //     back where the freeze left them (the caller bounds what it takes, by energy
 //     or overlap: crusher_breakage.h); "defer" leaves `state` as it was, and the caller keeps
@@ -128,6 +136,7 @@ struct FreezeSettings {
   double stall_window = 2.0;       // over this many of the heaviest fragment's sqrt(m/k); 0 = no stall rule
   double stall_max_overlap = 3e-4; // a stall ends the freeze only with the largest overlap at most this
   double max_contact_times = 100;  // crowded after this many of the heaviest mover's pi sqrt(m/k); 0 = max_cycles only
+  double jam_contact_times = 0;    // crowded sooner when at rest with the largest overlap not falling for this many; 0 = off
   std::int64_t max_cycles = 1000000;  // ...and never after more cycles than this
   CrowdedOutcome crowded = CrowdedOutcome::Break;  // at the cap: end "crowded" (break, defer) or stop the run
   std::int64_t check_cycles = 20;  // cycles between looks at the criterion (at most a quarter of the stall window)
@@ -147,6 +156,8 @@ struct FreezeResult {
   std::uint64_t stall_window_cycles = 0;  // the stall rule's window in cycles (0: off)
   double contact_time = 0.0;       // s, pi sqrt(m/k) of the heaviest mover at the freeze's mass and stiffness
   std::uint64_t cap_cycles = 0;    // the crowded cap in cycles: max_contact_times of those, at most max_cycles
+  std::uint64_t jam_window_cycles = 0;  // the jam rule's window in cycles (0: off)
+  bool jammed = false;             // crowded by the jam rule, before the cap
   double artificial_energy = 0.0;  // J, the fragments' overlaps at the freeze stiffness at the start
   double max_overlap = 0.0;        // largest fragment overlap / smaller radius (walls: / its radius) at the end
   double kinetic_energy = 0.0;     // J, at the end (freeze masses; "local": the movers')
@@ -185,5 +196,20 @@ struct FragmentOverlaps {
 };
 FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
                                   const std::vector<std::uint32_t>& fragments);
+
+/// The largest overlap of any of `movers` with any ball, over the smaller radius of
+/// the pair: fragmentOverlaps' max_fraction to the bit, which the freeze's criteria
+/// read every few cycles (building fragmentOverlaps' grid there took a sixth of a
+/// freeze). A largest value does not depend on the order in which the pairs come,
+/// so the balls are swept in order of x, in buffers kept from one look to the next:
+/// a mover meets only the balls whose x is within its radius and the largest one.
+class LargestOverlap {
+ public:
+  double operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers);
+
+ private:
+  std::vector<std::uint32_t> by_x_;
+  std::vector<double> x_;
+};
 
 }  // namespace rocklab::experiments::crusher

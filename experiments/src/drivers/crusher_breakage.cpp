@@ -53,6 +53,7 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   f.stall_window = b->number("freeze_stall_window", f.stall_window, Range::closed(0.0, 1e6));
   f.stall_max_overlap = b->number("freeze_stall_max_overlap", f.stall_max_overlap, Range::nonNegative());
   f.max_contact_times = b->number("freeze_max_contact_times", f.max_contact_times, Range::closed(0.0, 1e12));
+  f.jam_contact_times = b->number("freeze_jam_contact_times", f.jam_contact_times, Range::closed(0.0, 1e12));
   f.max_cycles = b->integer("freeze_max_cycles", f.max_cycles, {1.0, 1e12});
   f.check_cycles = b->integer("freeze_check_cycles", f.check_cycles, {1.0, 1e9});
   // The boolean before freeze_crowded (until 2026-12-04): a scene that still has it
@@ -258,6 +259,14 @@ bool CrusherBreakage::check(std::unique_ptr<sim::World>& world, const Experiment
   return changed;
 }
 
+double CrusherBreakage::strengthOf(std::uint32_t row, std::uint64_t id, double diameter) {
+  if (row >= kept_strengths_.size()) kept_strengths_.resize(row + 1);
+  KeptStrength& kept = kept_strengths_[row];
+  if (kept.id != id || kept.diameter != diameter)
+    kept = {id, diameter, s_.strength.strength(diameter, crusher::uniformFromId(seed_, id))};
+  return kept.strength;
+}
+
 bool CrusherBreakage::breakOverStrength(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
   const sim::ParticleState& p = world->particles();
   struct Broken {
@@ -274,7 +283,7 @@ bool CrusherBreakage::breakOverStrength(std::unique_ptr<sim::World>& world, cons
       continue;  // its fragments found no room a moment ago
     const double q = sim::octahedralShearStress(stress[i]);
     if (!(q > 0)) continue;
-    const double strength = s_.strength.strength(d, crusher::uniformFromId(seed_, p.id[i]));
+    const double strength = strengthOf(i, p.id[i], d);
     if (q > strength) broken.push_back({i, q, strength, sim::principalStresses(stress[i]).minor_direction});
   }
   if (broken.empty()) return false;
@@ -487,6 +496,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["max_crowded_handed_back_energy_J"] = max_crowded_handed_back_;
   b["max_handed_back_excess_J"] = freezes_ > 0 ? nlohmann::json(max_excess_) : nlohmann::json(nullptr);
   b["freeze_max_contact_times"] = s_.freeze.max_contact_times;
+  b["freeze_jam_contact_times"] = s_.freeze.jam_contact_times;
   b["freeze_scope"] = crusher::freezeScopeName(s_.freeze.scope);
   b["max_freeze_balls"] = max_freeze_balls_;
   b["freeze_reach_widenings"] = reach_widenings_;

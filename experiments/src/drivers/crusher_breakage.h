@@ -181,6 +181,17 @@ class CrusherBreakage {
   };
   std::vector<Deferral> deferrals_;
   std::map<std::uint64_t, double> deferred_until_;  // id -> time before which it does not break
+  /// The strength of the ball in `row` (id, diameter), drawn once and kept for the
+  /// checks that follow rather than two powers and a logarithm for every ball at
+  /// every check; a row that now holds another ball is drawn again. Not saved: the
+  /// draw depends on the seed and id alone.
+  double strengthOf(std::uint32_t row, std::uint64_t id, double diameter);
+  struct KeptStrength {
+    std::uint64_t id = 0;
+    double diameter = -1;  // m; no ball has it: the first look draws
+    double strength = 0;   // Pa
+  };
+  std::vector<KeptStrength> kept_strengths_;
   std::size_t fragments_created_ = 0;
   bool interrupted_ = false;
   double check_seconds_ = 0, freeze_seconds_ = 0;
