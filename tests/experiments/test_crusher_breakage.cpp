@@ -135,7 +135,7 @@ sim::Energy energyAfterStep(std::unique_ptr<sim::World>& world) {
 
 }  // namespace
 
-TEST_CASE("the fragments' overlaps found through a grid, and their largest through an x sweep, equal those of every ball "
+TEST_CASE("the fragments' overlaps found through a grid, and their largest through a cell grid, equal those of every ball "
           "against every fragment, bit for bit",
           "[experiments][crusher]") {
   // A loose heap of 3,000 balls of 2-14 mm, a hundred of them fragments, many touching.
@@ -174,7 +174,7 @@ TEST_CASE("the fragments' overlaps found through a grid, and their largest throu
   const crusher::FragmentOverlaps grid = crusher::fragmentOverlaps(model, p, fragments);
   CHECK(grid.max_fraction == all.max_fraction);
   CHECK(grid.energy == all.energy);
-  // The freeze's criteria read the largest through an x sweep: the same, bit for bit
+  // The freeze's criteria read the largest through a cell grid (counting sort): the same, bit for bit
   // (twice: the buffers are kept).
   crusher::LargestOverlap largest;
   CHECK(largest(p, fragments) == all.max_fraction);

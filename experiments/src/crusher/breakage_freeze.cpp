@@ -1,6 +1,7 @@
 #include "crusher/breakage_freeze.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -170,27 +171,53 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
 }
 
 double LargestOverlap::operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers) {
-  by_x_.resize(p.size());
-  std::iota(by_x_.begin(), by_x_.end(), 0u);
-  std::sort(by_x_.begin(), by_x_.end(),
-            [&](std::uint32_t a, std::uint32_t b) { return p.position[a].x() < p.position[b].x(); });
-  x_.resize(p.size());
-  for (std::size_t k = 0; k < by_x_.size(); ++k) x_[k] = p.position[by_x_[k]].x();
-  const double r_max = p.size() ? *std::max_element(p.radius.begin(), p.radius.end()) : 0.0;
+  if (movers.empty() || p.size() == 0) return 0.0;
+  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
+  if (!(r_max > 0)) return 0.0;
+  Vec3 lo = p.position[0], hi = p.position[0];
+  for (const Vec3& x : p.position) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  // Cells at least as wide as the largest pair reach: a ball touching f lies in one
+  // of the 27 cells around f's (the margin keeps a pair that only round-off
+  // separates on the inside). Wider cells where the balls' box would need too many.
+  double cell = 2.0 * r_max * (1 + 1e-9);
+  std::array<std::size_t, 3> dims{};
+  for (;; cell *= 2) {
+    for (int a = 0; a < 3; ++a) dims[a] = static_cast<std::size_t>((hi[a] - lo[a]) / cell) + 1;
+    if (static_cast<double>(dims[0]) * static_cast<double>(dims[1]) * static_cast<double>(dims[2]) <=
+        4.0 * static_cast<double>(p.size()) + 64)
+      break;
+  }
+  auto coord = [&](const Vec3& x, int a) { return static_cast<std::size_t>((x[a] - lo[a]) / cell); };
+  auto index = [&](std::size_t cx, std::size_t cy, std::size_t cz) { return (cz * dims[1] + cy) * dims[0] + cx; };
+  // The balls by cell (a counting sort into kept buffers).
+  cell_of_.resize(p.size());
+  first_.assign(dims[0] * dims[1] * dims[2] + 1, 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    cell_of_[i] = index(coord(p.position[i], 0), coord(p.position[i], 1), coord(p.position[i], 2));
+    ++first_[cell_of_[i] + 1];
+  }
+  for (std::size_t c = 1; c < first_.size(); ++c) first_[c] += first_[c - 1];
+  by_cell_.resize(p.size());
+  fill_.assign(first_.begin(), first_.end() - 1);
+  for (std::size_t i = 0; i < p.size(); ++i) by_cell_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
   double worst = 0;
   for (const std::uint32_t f : movers) {
-    // A ball further in x than this cannot touch f: the margin keeps a pair that
-    // only round-off separates (norm >= |dx| up to an ulp) on the inside.
-    const double reach = (p.radius[f] + r_max) * (1 + 1e-9);
-    const double x = p.position[f].x();
-    for (auto k = static_cast<std::size_t>(std::lower_bound(x_.begin(), x_.end(), x - reach) - x_.begin());
-         k < x_.size() && x_[k] <= x + reach; ++k) {
-      const std::uint32_t j = by_x_[k];
-      if (j == f) continue;
-      // fragmentOverlaps' expression, so the largest is the same to the bit.
-      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
-      if (overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
-    }
+    const std::array<std::size_t, 3> c{coord(p.position[f], 0), coord(p.position[f], 1), coord(p.position[f], 2)};
+    for (std::size_t z = c[2] > 0 ? c[2] - 1 : 0; z <= std::min(c[2] + 1, dims[2] - 1); ++z)
+      for (std::size_t y = c[1] > 0 ? c[1] - 1 : 0; y <= std::min(c[1] + 1, dims[1] - 1); ++y)
+        for (std::size_t x = c[0] > 0 ? c[0] - 1 : 0; x <= std::min(c[0] + 1, dims[0] - 1); ++x) {
+          const std::size_t k = index(x, y, z);
+          for (std::size_t m = first_[k]; m < first_[k + 1]; ++m) {
+            const std::uint32_t j = by_cell_[m];
+            if (j == f) continue;
+            // fragmentOverlaps' expression, so the largest is the same to the bit.
+            const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+            if (overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
+          }
+        }
   }
   return worst;
 }

@@ -201,15 +201,17 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
 /// the pair: fragmentOverlaps' max_fraction to the bit, which the freeze's criteria
 /// read every few cycles (building fragmentOverlaps' grid there took a sixth of a
 /// freeze). A largest value does not depend on the order in which the pairs come,
-/// so the balls are swept in order of x, in buffers kept from one look to the next:
-/// a mover meets only the balls whose x is within its radius and the largest one.
+/// so the balls are sorted into the cells of a box grid (a counting sort into
+/// buffers kept from one look to the next, no hashing) and a mover meets only the
+/// balls of the 27 cells around its own. (A sweep along x, tried first, met every
+/// ball of a feed pile in the bin: half a freeze's time at sigma0 = 0.8 MPa.)
 class LargestOverlap {
  public:
   double operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers);
 
  private:
-  std::vector<std::uint32_t> by_x_;
-  std::vector<double> x_;
+  std::vector<std::size_t> cell_of_, first_, fill_;
+  std::vector<std::uint32_t> by_cell_;
 };
 
 }  // namespace rocklab::experiments::crusher
