@@ -179,6 +179,10 @@ double LargestOverlap::operator()(const sim::ParticleState& p, const std::vector
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
   }
+  // A ball off to infinity (or NaN) has no cell; nothing the engine hands over has
+  // one, and were it to, "no room" is the safe answer (the freeze does not end as
+  // converged).
+  if (!(hi - lo).allFinite()) return std::numeric_limits<double>::infinity();
   // Cells at least as wide as the largest pair reach: a ball touching f lies in one
   // of the 27 cells around f's (the margin keeps a pair that only round-off
   // separates on the inside). Wider cells where the balls' box would need too many.
