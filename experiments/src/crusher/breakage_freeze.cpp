@@ -12,7 +12,6 @@
 #include <stdexcept>
 
 #include "rocklab/experiments/run.h"
-#include "rocklab/geometry/sphere_hash_grid.h"
 #include "rocklab/sim/timestep.h"
 #include "rocklab/sim/wall_motion.h"
 
@@ -135,6 +134,43 @@ const char* freezeEndName(FreezeEnd end) {
   return "converged";
 }
 
+bool BallCells::build(const sim::ParticleState& p) {
+  cell_of_.clear();
+  first_.assign(1, 0);
+  by_cell_.clear();
+  if (p.size() == 0) return true;
+  lo_ = hi_ = p.position[0];
+  for (const Vec3& x : p.position) {
+    lo_ = lo_.cwiseMin(x);
+    hi_ = hi_.cwiseMax(x);
+  }
+  if (!(hi_ - lo_).allFinite()) return false;
+  // Cells at least as wide as the largest pair reach: a ball touching f lies in one
+  // of the 27 cells around f's (the margin keeps a pair that only round-off
+  // separates on the inside). Wider cells where the balls' box would need too many.
+  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
+  cell_ = r_max > 0 ? 2.0 * r_max * (1 + 1e-9) : 1.0;
+  for (;; cell_ *= 2) {
+    for (int a = 0; a < 3; ++a) dims_[a] = static_cast<std::size_t>((hi_[a] - lo_[a]) / cell_) + 1;
+    if (static_cast<double>(dims_[0]) * static_cast<double>(dims_[1]) * static_cast<double>(dims_[2]) <=
+        4.0 * static_cast<double>(p.size()) + 64)
+      break;
+  }
+  // The balls by cell: a counting sort, in ball order within a cell.
+  cell_of_.resize(p.size());
+  first_.assign(dims_[0] * dims_[1] * dims_[2] + 1, 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const std::array<std::size_t, 3> c = cellOf(p.position[i]);
+    cell_of_[i] = index(c[0], c[1], c[2]);
+    ++first_[cell_of_[i] + 1];
+  }
+  for (std::size_t k = 1; k < first_.size(); ++k) first_[k] += first_[k - 1];
+  by_cell_.resize(p.size());
+  fill_.assign(first_.begin(), first_.end() - 1);
+  for (std::size_t i = 0; i < p.size(); ++i) by_cell_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  return true;
+}
+
 FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
                                   const std::vector<std::uint32_t>& fragments) {
   FragmentOverlaps o;
@@ -142,25 +178,20 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
   // The balls that can touch a fragment, from a grid of cells one largest diameter
   // wide (every ball against every fragment took four fifths of a run's time once a
   // weak feed had broken into thousands of balls and hundreds of fragments froze).
-  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
-  if (!(r_max > 0)) return o;
-  geometry::SphereHashGrid grid{2.0 * r_max, {}};
-  for (std::uint32_t j = 0; j < p.size(); ++j) grid.insert({p.position[j], p.radius[j]}, j);
+  BallCells cells;
+  if (!cells.build(p)) return {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   std::vector<bool> is_fragment(p.size(), false);
   for (const std::uint32_t f : fragments) is_fragment[f] = true;
   std::vector<std::pair<std::uint32_t, double>> touching;  // (ball, overlap) of one fragment
   for (const std::uint32_t f : fragments) {
     touching.clear();
-    grid.forEachNear(p.position[f], [&](const geometry::SphereHashGrid::Entry& e) {
-      const auto j = static_cast<std::uint32_t>(e.id);
+    cells.forEachNear(p.position[f], [&](std::uint32_t j) {
       if (j == f || (is_fragment[j] && j < f)) return;  // each fragment pair once
       const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
       if (overlap > 0) touching.emplace_back(j, overlap);
     });
-    // In ball order, the few that touch: the sums as over every ball. (Colliding
-    // cell keys visit a cell twice: its balls once.)
+    // In ball order, the few that touch: the sums as over every ball.
     std::sort(touching.begin(), touching.end());
-    touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
     for (const auto& [j, overlap] : touching) {
       o.max_fraction = std::max(o.max_fraction, overlap / std::min(p.radius[f], p.radius[j]));
       const double kf = model.materials[p.material[f]].kn, kj = model.materials[p.material[j]].kn;
@@ -171,58 +202,19 @@ FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleSt
 }
 
 double LargestOverlap::operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers) {
-  if (movers.empty() || p.size() == 0) return 0.0;
-  const double r_max = *std::max_element(p.radius.begin(), p.radius.end());
-  if (!(r_max > 0)) return 0.0;
-  Vec3 lo = p.position[0], hi = p.position[0];
-  for (const Vec3& x : p.position) {
-    lo = lo.cwiseMin(x);
-    hi = hi.cwiseMax(x);
-  }
+  if (movers.empty()) return 0.0;
   // A ball off to infinity (or NaN) has no cell; nothing the engine hands over has
   // one, and were it to, "no room" is the safe answer (the freeze does not end as
   // converged).
-  if (!(hi - lo).allFinite()) return std::numeric_limits<double>::infinity();
-  // Cells at least as wide as the largest pair reach: a ball touching f lies in one
-  // of the 27 cells around f's (the margin keeps a pair that only round-off
-  // separates on the inside). Wider cells where the balls' box would need too many.
-  double cell = 2.0 * r_max * (1 + 1e-9);
-  std::array<std::size_t, 3> dims{};
-  for (;; cell *= 2) {
-    for (int a = 0; a < 3; ++a) dims[a] = static_cast<std::size_t>((hi[a] - lo[a]) / cell) + 1;
-    if (static_cast<double>(dims[0]) * static_cast<double>(dims[1]) * static_cast<double>(dims[2]) <=
-        4.0 * static_cast<double>(p.size()) + 64)
-      break;
-  }
-  auto coord = [&](const Vec3& x, int a) { return static_cast<std::size_t>((x[a] - lo[a]) / cell); };
-  auto index = [&](std::size_t cx, std::size_t cy, std::size_t cz) { return (cz * dims[1] + cy) * dims[0] + cx; };
-  // The balls by cell (a counting sort into kept buffers).
-  cell_of_.resize(p.size());
-  first_.assign(dims[0] * dims[1] * dims[2] + 1, 0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    cell_of_[i] = index(coord(p.position[i], 0), coord(p.position[i], 1), coord(p.position[i], 2));
-    ++first_[cell_of_[i] + 1];
-  }
-  for (std::size_t c = 1; c < first_.size(); ++c) first_[c] += first_[c - 1];
-  by_cell_.resize(p.size());
-  fill_.assign(first_.begin(), first_.end() - 1);
-  for (std::size_t i = 0; i < p.size(); ++i) by_cell_[fill_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  if (!cells_.build(p)) return std::numeric_limits<double>::infinity();
   double worst = 0;
-  for (const std::uint32_t f : movers) {
-    const std::array<std::size_t, 3> c{coord(p.position[f], 0), coord(p.position[f], 1), coord(p.position[f], 2)};
-    for (std::size_t z = c[2] > 0 ? c[2] - 1 : 0; z <= std::min(c[2] + 1, dims[2] - 1); ++z)
-      for (std::size_t y = c[1] > 0 ? c[1] - 1 : 0; y <= std::min(c[1] + 1, dims[1] - 1); ++y)
-        for (std::size_t x = c[0] > 0 ? c[0] - 1 : 0; x <= std::min(c[0] + 1, dims[0] - 1); ++x) {
-          const std::size_t k = index(x, y, z);
-          for (std::size_t m = first_[k]; m < first_[k + 1]; ++m) {
-            const std::uint32_t j = by_cell_[m];
-            if (j == f) continue;
-            // fragmentOverlaps' expression, so the largest is the same to the bit.
-            const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
-            if (overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
-          }
-        }
-  }
+  for (const std::uint32_t f : movers)
+    cells_.forEachNear(p.position[f], [&](std::uint32_t j) {
+      if (j == f) return;
+      // fragmentOverlaps' expression, so the largest is the same to the bit.
+      const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+      if (overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
+    });
   return worst;
 }
 

@@ -108,6 +108,8 @@
 //
 // Only the positions (and the contact history at them) come back; masses,
 // stiffnesses, damping, gravity, wall motion and velocities are the run's again.
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -197,21 +199,58 @@ struct FragmentOverlaps {
 FragmentOverlaps fragmentOverlaps(const sim::Model& model, const sim::ParticleState& p,
                                   const std::vector<std::uint32_t>& fragments);
 
+/// The balls of a state sorted into the cells of a box grid, each cell at least one
+/// largest diameter wide, so that every ball touching a point's ball lies in the 27
+/// cells around it: a counting sort into buffers that a kept object reuses, no
+/// hashing (geometry::SphereHashGrid allocated a list per cell at every look of the
+/// freeze's criteria). fragmentOverlaps and LargestOverlap find the balls near a
+/// fragment through it.
+class BallCells {
+ public:
+  /// Sorts the balls of `p`; false (and no cells) when a position is not finite.
+  bool build(const sim::ParticleState& p);
+  /// Calls visit(j) for every ball j in the 27 cells around x (x among the balls'
+  /// box), cells in z, y, x order and balls in ball order within a cell.
+  template <class Visit>
+  void forEachNear(const geometry::Vec3& x, Visit&& visit) const {
+    if (by_cell_.empty()) return;
+    const std::array<std::size_t, 3> c = cellOf(x);
+    for (std::size_t z = c[2] > 0 ? c[2] - 1 : 0; z <= std::min(c[2] + 1, dims_[2] - 1); ++z)
+      for (std::size_t y = c[1] > 0 ? c[1] - 1 : 0; y <= std::min(c[1] + 1, dims_[1] - 1); ++y)
+        for (std::size_t cx = c[0] > 0 ? c[0] - 1 : 0; cx <= std::min(c[0] + 1, dims_[0] - 1); ++cx) {
+          const std::size_t k = index(cx, y, z);
+          for (std::size_t m = first_[k]; m < first_[k + 1]; ++m) visit(by_cell_[m]);
+        }
+  }
+
+ private:
+  std::array<std::size_t, 3> cellOf(const geometry::Vec3& x) const {
+    return {static_cast<std::size_t>((x[0] - lo_[0]) / cell_), static_cast<std::size_t>((x[1] - lo_[1]) / cell_),
+            static_cast<std::size_t>((x[2] - lo_[2]) / cell_)};
+  }
+  std::size_t index(std::size_t cx, std::size_t cy, std::size_t cz) const {
+    return (cz * dims_[1] + cy) * dims_[0] + cx;
+  }
+  geometry::Vec3 lo_ = geometry::Vec3::Zero(), hi_ = geometry::Vec3::Zero();
+  double cell_ = 1.0;
+  std::array<std::size_t, 3> dims_{1, 1, 1};
+  std::vector<std::size_t> cell_of_, first_, fill_;
+  std::vector<std::uint32_t> by_cell_;
+};
+
 /// The largest overlap of any of `movers` with any ball, over the smaller radius of
 /// the pair: fragmentOverlaps' max_fraction to the bit, which the freeze's criteria
-/// read every few cycles (building fragmentOverlaps' grid there took a sixth of a
-/// freeze). A largest value does not depend on the order in which the pairs come,
-/// so the balls are sorted into the cells of a box grid (a counting sort into
-/// buffers kept from one look to the next, no hashing) and a mover meets only the
-/// balls of the 27 cells around its own. (A sweep along x, tried first, met every
-/// ball of a feed pile in the bin: half a freeze's time at sigma0 = 0.8 MPa.)
+/// read every few cycles (building a hash grid there took a sixth of a freeze). A
+/// largest value does not depend on the order in which the pairs come, so it needs
+/// no sort; the cells are kept from one look to the next. (A sweep along x, tried
+/// first, met every ball of a feed pile in the bin: half a freeze's time at sigma0
+/// = 0.8 MPa.)
 class LargestOverlap {
  public:
   double operator()(const sim::ParticleState& p, const std::vector<std::uint32_t>& movers);
 
  private:
-  std::vector<std::size_t> cell_of_, first_, fill_;
-  std::vector<std::uint32_t> by_cell_;
+  BallCells cells_;
 };
 
 }  // namespace rocklab::experiments::crusher
