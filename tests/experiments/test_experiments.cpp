@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "cli_support.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 #include "rocklab/experiments/sweep.h"
@@ -340,4 +341,74 @@ TEST_CASE("zoned chute: the top plate cuts the deposited bed - what reached it g
   REQUIRE(seen_after);
   CHECK(before >= static_cast<std::size_t>(removed) / 2);  // the bed did reach the plate (within 1 mm)
   CHECK(after == 0);
+}
+
+TEST_CASE("zoned chute: stopped in its deposit or in its flow and restarted, it ends as the straight run, bit for bit",
+          "[experiment][restart]") {
+  // The driver saves its phase, the deposit's and the gate's times, the markers and
+  // the discharge so far; a restart rebuilds the model of that phase (gravity, the
+  // zone walls gone, the top plate placed, the gate open) from the saved times.
+  std::vector<std::string> o = soft({"small", "medium", "large", "steel_base", "perspex"}, 1e6);
+  for (const char* s : {"particles.0.count=150", "particles.1.count=120", "particles.2.count=100",
+                        "particles.0.region_max=[0.2, 0.3, 0.3]", "particles.1.region_max=[0.4, 0.3, 0.35]",
+                        "particles.2.region_max=[0.6, 0.3, 0.4]", "experiment.tilt_steps=300",
+                        "output.checkpoint=true", "output.frame_interval=0.1"})
+    o.push_back(s);
+  const fs::path dir = test::scratchDir("zoned-restart");
+  const auto run = [&](const std::string& out, const std::string& end_time) {
+    std::vector<std::string> args{"run", kAssets + "zoned-chute.toml", "--out", (dir / out).string(), "--threads", "1",
+                                  "--quiet"};
+    for (const std::string& s : o) args.insert(args.end(), {"--set", s});
+    if (!end_time.empty()) args.insert(args.end(), {"--set", "scene.end_time=" + end_time});
+    return test::cli(args);
+  };
+  const auto results = [&](const std::string& out) {
+    std::ifstream in(dir / out / "results.json");
+    return json::parse(in);
+  };
+  REQUIRE(run("straight", "") == 0);
+  const json straight = results("straight");
+  REQUIRE(straight["clearance_time_s"].is_number());
+  const double deposit_end = straight["chute"]["deposit_end_s"].get<double>();
+  const double gate = straight["chute"]["gate_open_s"].get<double>();
+  const double flow_mid = gate + 0.5 * straight["clearance_time_s"].get<double>();
+  for (const double stop : {0.6 * deposit_end, flow_mid}) {
+    const std::string first = "to-" + std::to_string(stop), second = "from-" + std::to_string(stop);
+    REQUIRE(run(first, std::to_string(stop)) == 0);
+    if (stop > gate) CHECK(results(first)["chute"]["discharged_bodies"].get<int>() > 0);  // stopped mid-flow
+    REQUIRE(test::cli({"restart", (dir / first / "checkpoint.h5").string(), "--out", (dir / second).string(),
+                       "--threads", "2", "--quiet", "--set", "scene.end_time=8.0"}) == 0);
+    const json restarted = results(second);
+    INFO("stopped at t = " << stop << " s");
+    CHECK(restarted["state_hash"] == straight["state_hash"]);
+    CHECK(restarted["clearance_time_s"] == straight["clearance_time_s"]);
+    CHECK(restarted["markers"] == straight["markers"]);
+    CHECK(restarted["profile"] == straight["profile"]);
+    for (const char* key : {"deposit_end_s", "gate_open_s", "bodies", "bodies_removed_by_top_plate",
+                            "discharged_bodies", "discharged_mass_kg"})
+      CHECK(restarted["chute"][key] == straight["chute"][key]);
+    CHECK(test::slurp(dir / second / "discharge.csv") == test::slurp(dir / "straight" / "discharge.csv"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("chute: a run filmed for tracking is not restarted after its deposit, and says why", "[experiment][restart]") {
+  // The tracker's frames are not in the checkpoint: a restart after the markers were
+  // chosen would track half a flow. The checkpoint at the run's end is refused with
+  // exit code 2, naming the camera; nothing is written.
+  const fs::path dir = test::scratchDir("chute-tracked-restart");
+  std::vector<std::string> args{"run", kAssets + "chute-30-clumps.toml", "--out", (dir / "first").string(), "--quiet"};
+  auto o = soft({"pebble", "steel", "perspex"}, 1e6);
+  for (const char* s : {"particles.0.count=150", "particles.0.region_max=[0.6, 0.3, 0.1]", "experiment.marker_heights=[0.01]",
+                        "experiment.tilt_steps=200", "cameras.side.frame_rate=20", "cameras.side.movie=false",
+                        "output.checkpoint=true"})
+    o.push_back(s);
+  for (const std::string& s : o) args.insert(args.end(), {"--set", s});
+  REQUIRE(test::cli(args) == 0);
+  std::string log;
+  CHECK(test::cliLogged({"restart", (dir / "first" / "checkpoint.h5").string(), "--out", (dir / "second").string()},
+                        log) == kExitBadInput);
+  CHECK_THAT(log, Catch::Contains("tracks camera 'side'"));
+  CHECK_FALSE(fs::exists(dir / "second" / "results.json"));
+  fs::remove_all(dir);
 }

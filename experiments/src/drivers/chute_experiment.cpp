@@ -16,12 +16,14 @@
 #include "drivers/chute_experiment.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <unordered_set>
 
 #include "analysis/marker_tracking.h"
@@ -62,6 +64,39 @@ nlohmann::json orNull(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
+// A restart's state (saveState): every member, NaN included (CBOR keeps it).
+std::array<double, 3> asArray(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Vec3 asVec3(const nlohmann::json& j) {
+  const auto a = j.get<std::array<double, 3>>();
+  return {a[0], a[1], a[2]};
+}
+void to_json(nlohmann::json& j, const Marker& m) {
+  j = {{"id", m.id},
+       {"column", m.column},
+       {"row", m.row},
+       {"target", asArray(m.target)},
+       {"start", asArray(m.start)},
+       {"last_travel", m.last_travel},
+       {"last_time", m.last_time},
+       {"onset_time", m.onset_time},
+       {"travel_time", m.travel_time},
+       {"velocity", m.velocity},
+       {"velocity_from_gate", m.velocity_from_gate}};
+}
+void from_json(const nlohmann::json& j, Marker& m) {
+  j.at("id").get_to(m.id);
+  j.at("column").get_to(m.column);
+  j.at("row").get_to(m.row);
+  m.target = asVec3(j.at("target"));
+  m.start = asVec3(j.at("start"));
+  j.at("last_travel").get_to(m.last_travel);
+  j.at("last_time").get_to(m.last_time);
+  j.at("onset_time").get_to(m.onset_time);
+  j.at("travel_time").get_to(m.travel_time);
+  j.at("velocity").get_to(m.velocity);
+  j.at("velocity_from_gate").get_to(m.velocity_from_gate);
+}
+
 class ChuteExperiment final : public Experiment {
  public:
   explicit ChuteExperiment(const Scene& scene)
@@ -86,17 +121,16 @@ class ChuteExperiment final : public Experiment {
   }
 
   bool advance(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) override {
+    if (phase_ == Phase::Done) return false;
     if (phase_ == Phase::Start) {
       every_ = stepsIn(e_.sample_interval, world->dt());
-      switchPhase(world, ctx, [&](sim::Model& m) {
-        m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
-        m.gravity_changes.clear();  // the experiment owns gravity
-        if (!e_.top_wall.empty())
-          m.walls[wallIndex(m, e_.top_wall)].active_from =
-              std::numeric_limits<double>::max();  // until placed
-      });
+      switchPhase(world, ctx, [&](sim::Model& m) { depositModel(m); });
       phase_ = Phase::Deposit;
       bodies_total_ = indexBodies(world->particles()).size();
+    }
+    if (restored_) {  // the bodies' places in the World the checkpoint made
+      bodies_ = indexBodies(world->particles());
+      restored_ = false;
     }
     const std::uint64_t step = world->stepCount();
     if (phase_ == Phase::Tilt) {
@@ -144,8 +178,86 @@ class ChuteExperiment final : public Experiment {
     return ids;
   }
 
+  bool restartable() const override { return true; }
+
+  nlohmann::json saveState() const override {
+    nlohmann::json j;
+    savedFields(*this, [&j](const char* key, const auto& value) { j[key] = value; });
+    std::vector<std::uint64_t> discharged(discharged_.begin(), discharged_.end());
+    std::sort(discharged.begin(), discharged.end());
+    j["discharged"] = discharged;
+    j["top_point"] = asArray(top_point_);
+    j["top_normal"] = asArray(top_normal_);
+    return j;
+  }
+
+  /// The phase, its figures so far and the model of that phase (gravity, the walls
+  /// placed or gone at the saved times). The tracker's frames are not saved: a
+  /// chute filmed for tracking restarts from its deposit only.
+  void restoreState(const nlohmann::json& j, sim::Model& model) override {
+    savedFields(*this, [&j](const char* key, auto& value) { j.at(key).get_to(value); });
+    const auto discharged = j.at("discharged").get<std::vector<std::uint64_t>>();
+    discharged_ = {discharged.begin(), discharged.end()};
+    top_point_ = asVec3(j.at("top_point"));
+    top_normal_ = asVec3(j.at("top_normal"));
+    if (phase_ < Phase::Start || phase_ > Phase::Done)
+      throw std::invalid_argument("phase " + std::to_string(static_cast<int>(phase_)) + " (allowed: 0 to 4)");
+    if (every_ == 0) throw std::invalid_argument("sample every 0 steps (allowed: at least 1)");
+    if (!tracking_error_.empty()) tracking_.reset();
+    if (tracking_ && phase_ >= Phase::Tilt)
+      throw std::invalid_argument("saved after the deposit of a run that tracks camera '" + e_.track_camera +
+                                  "': the tracker's frames are not in a checkpoint (a tracked chute restarts from a "
+                                  "checkpoint of its deposit, or run the scene again)");
+    if (phase_ >= Phase::Deposit) depositModel(model);
+    if (phase_ >= Phase::Tilt) testModel(model, deposit_time_);
+    if (phase_ >= Phase::Flow) gateModel(model, gate_time_);
+    restored_ = true;
+  }
+
  private:
   enum class Phase { Start, Deposit, Tilt, Flow, Done };
+
+  // The model of each phase, from the time it began: the run's phase switches and
+  // a restart (restoreState) make it the same way.
+  void depositModel(sim::Model& m) const {
+    m.gravity = tiltedGravity(g_, e_.deposit_inclination_deg, e_.rotate_gravity);
+    m.gravity_changes.clear();  // the experiment owns gravity
+    if (!e_.top_wall.empty())
+      m.walls[wallIndex(m, e_.top_wall)].active_from = std::numeric_limits<double>::max();  // until placed
+  }
+  /// From `t` (the deposit's end): temporary walls gone, the top plate placed, gravity at the test angle.
+  void testModel(sim::Model& m, double t) const {
+    for (const std::string& name : e_.temporary_walls) m.walls[wallIndex(m, name)].active_until = t;
+    if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = t;
+    m.gravity = tiltedGravity(g_, e_.inclination_deg, e_.rotate_gravity);
+  }
+  void gateModel(sim::Model& m, double t) const { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; }
+
+  /// What saveState writes and restoreState reads (but the discharged ids and the
+  /// top plate's plane): each member once, as f(key, member), for a const or a
+  /// mutable self.
+  template <class Self, class F>
+  static void savedFields(Self& self, F&& f) {
+    f("phase", self.phase_);
+    f("every", self.every_);
+    f("tilt_end_step", self.tilt_end_step_);
+    f("bodies_total", self.bodies_total_);
+    f("removed_by_top", self.removed_by_top_);
+    f("settle", self.settle_);
+    f("jammed", self.jammed_);
+    f("deposit_time", self.deposit_time_);
+    f("gate_time", self.gate_time_);
+    f("last_discharge", self.last_discharge_);
+    f("clearance_time", self.clearance_time_);
+    f("bed_height", self.bed_height_);
+    f("markers", self.markers_);
+    f("discharged_count", self.discharged_count_);
+    f("discharged_mass", self.discharged_mass_);
+    f("discharge_curve", self.discharge_curve_);
+    f("checks_since_removal", self.checks_since_removal_);
+    f("has_top", self.has_top_);
+    f("tracking_error", self.tracking_error_);
+  }
 
   void endDeposit(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
@@ -177,14 +289,7 @@ class ChuteExperiment final : public Experiment {
       bed_height_ = tops[static_cast<std::size_t>(0.95 * static_cast<double>(tops.size() - 1))];
     }
     switchPhase(
-        world, ctx,
-        [&](sim::Model& m) {
-          for (const std::string& name : e_.temporary_walls)
-            m.walls[wallIndex(m, name)].active_until = t;
-          if (!e_.top_wall.empty()) m.walls[wallIndex(m, e_.top_wall)].active_from = t;
-          m.gravity = tiltedGravity(g_, e_.inclination_deg, e_.rotate_gravity);
-        },
-        remove);
+        world, ctx, [&](sim::Model& m) { testModel(m, t); }, remove);
     bodies_ = indexBodies(world->particles());
     removed_by_top_ = bodies_total_ - bodies_.size();
     bodies_total_ = bodies_.size();
@@ -321,8 +426,7 @@ class ChuteExperiment final : public Experiment {
 
   void openGate(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
-    switchPhase(world, ctx,
-                [&](sim::Model& m) { m.walls[wallIndex(m, e_.gate_wall)].active_until = t; });
+    switchPhase(world, ctx, [&](sim::Model& m) { gateModel(m, t); });
     gate_time_ = last_discharge_ = t;
     // The lab sees the gate open in its film: travel counts from there, as the
     // truth's does (the bed creeps a few mm while the chute tilts; that must not count).
@@ -432,6 +536,7 @@ class ChuteExperiment final : public Experiment {
   double discharged_mass_ = 0;
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
+  bool restored_ = false;  // by restoreState: bodies_ is made again from the World at the next advance
   std::unique_ptr<MarkerTracking> tracking_;
   MarkerTruth truth_;  // marker centres at every sample from the gate opening (tracking report only)
   CameraSettings

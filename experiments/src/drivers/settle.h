@@ -4,6 +4,8 @@
 // ball is faster than settle_speed, looked at on the driver's sample steps and
 // not before settle_min_time; at settle_max_time it ends unsettled, and the
 // report says so instead of hiding it.
+#include <nlohmann/json.hpp>
+
 #include "drivers/experiment.h"
 #include "drivers/experiment_settings.h"
 
@@ -25,6 +27,8 @@ class SettleDetector {
   bool settled() const { return settled_; }
   /// m/s, the largest ball speed at the last sample.
   double maxSpeed() const { return speed_; }
+  // A restart's state (the limits are the scene's).
+  NLOHMANN_DEFINE_TYPE_INTRUSIVE(SettleDetector, settled_, speed_)
 
  private:
   double speed_limit_, min_time_, max_time_;  // m/s, s, s

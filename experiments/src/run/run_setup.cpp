@@ -22,7 +22,7 @@ std::string restoreExperiment(const Scene& scene, const std::vector<std::uint8_t
   const std::string type = "experiment." + scene.experiment_type;
   if (!experiment.restartable())
     return type + " scenes cannot be restarted from a checkpoint yet (the experiment's phase is not saved; "
-                  "restartable: experiment.crusher); run the scene again";
+                  "restartable: experiment.crusher and experiment.chute); run the scene again";
   if (bytes.empty())
     return "holds no /experiment (the state of the " + type +
            " driver: written by a run of another scene, or by a rocklab before experiment restarts); run the "
