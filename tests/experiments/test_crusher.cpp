@@ -197,6 +197,41 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
   CHECK(fs::exists(whiten / "whiten.png"));
   CHECK(test::cli({"whiten", out.string(), "--k1-mm", "9", "--k2-mm", "8"}) == 2);
   CHECK(test::cli({"whiten", whiten.string()}) == 2);  // no results.json there
+  // `rocklab products`: the run's curve and figures in the table as results.json has
+  // them; a folder without a crusher run, a damaged curve, or labels that are not one
+  // a run are bad input, and nothing is written.
+  const fs::path products = test::scratchDir("crusher-run-products");
+  REQUIRE(test::cli({"products", out.string(), out.string(), "--label", "first", "--label", "second", "--out",
+                     products.string()}) == 0);
+  {
+    std::ifstream p_in(products / "products.json");
+    const auto p = nlohmann::json::parse(p_in);
+    REQUIRE(p["runs"].size() == 2);
+    CHECK(p["runs"][1]["label"] == "second");
+    CHECK(p["runs"][0]["psd"] == c["psd"]);
+    CHECK(p["runs"][0]["p80_mm"] == c["p80_mm"]);
+    CHECK(p["runs"][0]["feed"] == "spheres");
+    const std::string table = test::slurp(products / "products.csv");
+    CHECK(std::count(table.begin(), table.end(), '\n') == 3);  // header + 2 runs
+    CHECK(fs::exists(products / "product_curves.png"));
+  }
+  const fs::path damaged = test::scratchDir("crusher-run-damaged");
+  fs::create_directories(damaged);
+  {
+    std::ifstream r_in(out / "results.json");
+    auto bad = nlohmann::json::parse(r_in);
+    bad["crusher"]["psd"][2]["passing"] = 1.5;
+    std::ofstream(damaged / "results.json") << bad.dump();
+  }
+  const fs::path nothing = test::scratchDir("crusher-run-products-bad");
+  std::string log;
+  CHECK(test::cliLogged({"products", out.string(), damaged.string(), "--out", nothing.string()}, log) == 2);
+  CHECK_THAT(log, Catch::Contains("crusher.psd") && Catch::Contains("passing within 0 and 1"));
+  CHECK(test::cli({"products", out.string(), whiten.string(), "--out", nothing.string()}) == 2);
+  CHECK(test::cli({"products", out.string(), "--label", "a", "--label", "b", "--out", nothing.string()}) == 2);
+  CHECK_FALSE(fs::exists(nothing));
+  fs::remove_all(products);
+  fs::remove_all(damaged);
   fs::remove_all(whiten);
   CHECK(fs::exists(out / "vtk/walls.pvd"));
   CHECK(fs::exists(out / "vtk/walls_000001.vtp"));

@@ -16,6 +16,7 @@
 #include "analysis/strength_groups.h"
 #include "analysis/weibull_report.h"
 #include "crusher/crusher_geometry_command.h"
+#include "crusher/products_command.h"
 #include "crusher/whiten_command.h"
 #include "report/run_report.h"
 #include "camera/render_run.h"
@@ -58,6 +59,7 @@ Examples:
   rocklab scene-keys > docs/scene-format.md      # the scene file reference, from the readers
   rocklab crusher-geometry cone-crusher --set crusher.css=0.012   # chamber quantities + section.png
   rocklab whiten out/crusher --k1-mm 12 --k2-mm 25   # Whiten's model on a crusher run's feed
+  rocklab products out/pbm out/bpm --label PBM --label BPM --out out/pbm-bpm   # product curves side by side
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -176,6 +178,8 @@ struct CliArgs {
   int count = 30, trials = 3, trial_orientations = 1;
   // whiten
   WhitenCommandOptions whiten;
+  // products
+  ProductsCommandOptions products;
 };
 
 /// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
@@ -270,6 +274,12 @@ void addCommands(CLI::App& app, CliArgs& a) {
   whiten->add_option("--exponent", a.whiten.exponent, "Exponent of Eq 3-22 (default 2, as the study prints it)");
   whiten->add_option("--mode", a.whiten.mode, "Breakage split: triple (60/30/10 %) or equal (default: the run's)");
   whiten->add_option("--out", a.out_dir, "Folder for whiten.json and whiten.png (default: the run's folder)");
+  auto* products = app.add_subcommand(
+      "products", "Product curves of finished crusher runs on one sieve chart, with their P50, P80 and breakages");
+  products->add_option("runs", a.products.runs, "Folders of finished crusher runs (their results.json)")->required();
+  products->add_option("--label", a.products.labels, "A legend label a run, in their order (default: the folders' names)")
+      ->take_all();
+  products->add_option("--out", a.out_dir, "Folder for products.csv, products.json and product_curves.png (default: out/products)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -540,6 +550,10 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     a.whiten.run_dir = a.collect_dir;
     a.whiten.out_dir = a.out_dir;
     return runWhitenCommand(a.whiten, std::cout, std::cerr);
+  }
+  if (app.got_subcommand("products")) {
+    a.products.out_dir = a.out_dir.empty() ? std::filesystem::path("out/products") : std::filesystem::path(a.out_dir);
+    return runProductsCommand(a.products, std::cout, std::cerr);
   }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);

@@ -8,58 +8,31 @@
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "crusher/breakage_model.h"
+#include "crusher/psd_curve.h"
 #include "crusher/whiten_model.h"
 #include "drivers/crusher_whiten.h"
 #include "rocklab/experiments/run.h"
 
 namespace rocklab::experiments {
 
-namespace {
-
-struct BadInput : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-const nlohmann::json& need(const nlohmann::json& j, const std::string& key, const std::string& where) {
-  if (!j.is_object() || !j.contains(key)) throw BadInput(where + ": no key '" + key + "'");
-  return j.at(key);
-}
-
-/// A sieve curve (list of {size_mm, passing}) as sizes and fractions, checked.
-void readCurve(const nlohmann::json& curve, const std::string& where, std::vector<double>& sizes,
-               std::vector<double>& passing) {
-  if (!curve.is_array() || curve.size() < 2) throw BadInput(where + ": must list at least two {size_mm, passing}");
-  for (const nlohmann::json& point : curve) {
-    const nlohmann::json& s = need(point, "size_mm", where);
-    const nlohmann::json& p = need(point, "passing", where);
-    if (!s.is_number() || !p.is_number() || !(p.get<double>() >= 0 && p.get<double>() <= 1) || !(s.get<double>() > 0))
-      throw BadInput(where + ": size_mm must be > 0 and passing within 0 and 1, got " + point.dump());
-    if (!sizes.empty() && !(s.get<double>() > sizes.back())) throw BadInput(where + ": sizes must increase");
-    sizes.push_back(s.get<double>());
-    passing.push_back(p.get<double>());
-  }
-}
-
-}  // namespace
-
 int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostream& err) {
   const std::filesystem::path file = o.run_dir / "results.json";
   try {
     std::ifstream in(file);
-    if (!in) throw BadInput("cannot read (a crusher run's folder holds it)");
+    if (!in) throw crusher::PsdInputError("cannot read (a crusher run's folder holds it)");
     nlohmann::json r;
     try {
       r = nlohmann::json::parse(in);
     } catch (const nlohmann::json::exception& e) {
-      throw BadInput(std::string("not JSON: ") + e.what());
+      throw crusher::PsdInputError(std::string("not JSON: ") + e.what());
     }
-    const nlohmann::json& c = need(r, "crusher", "results.json (not a crusher run)");
+    const nlohmann::json& c = crusher::needKey(r, "crusher", "results.json (not a crusher run)");
     std::vector<double> sieves, feed_passing, sizes, product_passing;
-    readCurve(need(c, "feed_psd", "crusher"), "crusher.feed_psd", sieves, feed_passing);
-    readCurve(need(c, "psd", "crusher"), "crusher.psd", sizes, product_passing);
-    if (sizes != sieves) throw BadInput("crusher.psd: its sizes differ from crusher.feed_psd's");
-    const nlohmann::json& mass_j = need(c, "feed_mass_kg", "crusher");
-    if (!mass_j.is_number() || !(mass_j.get<double>() > 0)) throw BadInput("crusher.feed_mass_kg: must be > 0");
+    crusher::readSieveCurve(crusher::needKey(c, "feed_psd", "crusher"), "crusher.feed_psd", sieves, feed_passing);
+    crusher::readSieveCurve(crusher::needKey(c, "psd", "crusher"), "crusher.psd", sizes, product_passing);
+    if (sizes != sieves) throw crusher::PsdInputError("crusher.psd: its sizes differ from crusher.feed_psd's");
+    const nlohmann::json& mass_j = crusher::needKey(c, "feed_mass_kg", "crusher");
+    if (!mass_j.is_number() || !(mass_j.get<double>() > 0)) throw crusher::PsdInputError("crusher.feed_mass_kg: must be > 0");
     const double feed_mass = mass_j.get<double>();
     // Mass per class, coarse to fine (crusher::SizeClasses): the top class above the
     // largest sieve, the pan below the smallest.
@@ -69,7 +42,7 @@ int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostr
     for (std::size_t k = 1; k < n; ++k)
       feed[static_cast<Eigen::Index>(k)] = (feed_passing[n - k] - feed_passing[n - 1 - k]) * feed_mass;
     feed[static_cast<Eigen::Index>(n)] = feed_passing[0] * feed_mass;
-    if ((feed.array() < -1e-12 * feed_mass).any()) throw BadInput("crusher.feed_psd: passing must not decrease");
+    if ((feed.array() < -1e-12 * feed_mass).any()) throw crusher::PsdInputError("crusher.feed_psd: passing must not decrease");
     feed = feed.cwiseMax(0.0);
 
     // The run's own settings unless asked otherwise.
@@ -82,14 +55,14 @@ int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostr
     const std::optional<double> k1 = o.k1_mm ? o.k1_mm : runValue("k1_mm");
     const std::optional<double> k2 = o.k2_mm ? o.k2_mm : runValue("k2_mm");
     if (!k1 || !k2)
-      throw BadInput("crusher.whiten.from_parameters has no k1_mm / k2_mm (a run without a [crusher] chamber): give "
+      throw crusher::PsdInputError("crusher.whiten.from_parameters has no k1_mm / k2_mm (a run without a [crusher] chamber): give "
                      "--k1-mm and --k2-mm");
     if (!(*k1 > 0 && *k1 < *k2))
-      throw BadInput("--k1-mm / --k2-mm: need 0 < k1 < k2, got " + std::to_string(*k1) + " and " + std::to_string(*k2));
-    if (!(o.exponent > 0)) throw BadInput("--exponent: must be > 0");
+      throw crusher::PsdInputError("--k1-mm / --k2-mm: need 0 < k1 < k2, got " + std::to_string(*k1) + " and " + std::to_string(*k2));
+    if (!(o.exponent > 0)) throw crusher::PsdInputError("--exponent: must be > 0");
     std::string mode = o.mode;
     if (mode.empty()) mode = run_params.contains("split") && run_params["split"].is_string() ? run_params["split"].get<std::string>() : "triple";
-    if (mode != "triple" && mode != "equal") throw BadInput("--mode: must be triple or equal, got '" + mode + "'");
+    if (mode != "triple" && mode != "equal") throw crusher::PsdInputError("--mode: must be triple or equal, got '" + mode + "'");
     const crusher::SplitMode split = mode == "equal" ? crusher::SplitMode::Equal : crusher::SplitMode::Triple;
 
     const WhitenPrediction w = whitenFromParameters(sieves, feed, *k1 * 1e-3, *k2 * 1e-3, o.exponent, split);
@@ -129,7 +102,7 @@ int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostr
     writePlot(spec, dir / "whiten.png");
     out << "wrote " << (dir / "whiten.json").string() << " and whiten.png\n";
     return 0;
-  } catch (const BadInput& e) {
+  } catch (const crusher::PsdInputError& e) {
     err << "error: " << file.string() << ": " << e.what() << '\n';
     return kExitBadInput;
   } catch (const crusher::WhitenInputError& e) {

@@ -1,0 +1,172 @@
+#include "crusher/products_command.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "analysis/plot.h"
+#include "common/atomic_file.h"
+#include "crusher/psd_curve.h"
+#include "rocklab/experiments/run.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+struct ProductRun {
+  std::string label;
+  std::filesystem::path dir;
+  std::vector<double> sieves, passing, feed_passing;  // mm; fractions
+  nlohmann::json figures;                             // the table's row
+};
+
+/// A number of `c` at `key`, NaN when it is missing or null (a run with no product).
+double numberOr(const nlohmann::json& c, const char* key) {
+  return c.contains(key) && c[key].is_number() ? c[key].get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+ProductRun readRun(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "results.json");
+  if (!in) throw crusher::PsdInputError("cannot read (a crusher run's folder holds it)");
+  nlohmann::json r;
+  try {
+    r = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw crusher::PsdInputError(std::string("not JSON: ") + e.what());
+  }
+  const nlohmann::json& c = crusher::needKey(r, "crusher", "results.json (not a crusher run)");
+  ProductRun run;
+  run.dir = dir;
+  std::vector<double> feed_sieves;
+  crusher::readSieveCurve(crusher::needKey(c, "psd", "crusher"), "crusher.psd", run.sieves, run.passing);
+  crusher::readSieveCurve(crusher::needKey(c, "feed_psd", "crusher"), "crusher.feed_psd", feed_sieves,
+                          run.feed_passing);
+  if (feed_sieves != run.sieves) throw crusher::PsdInputError("crusher.psd: its sizes differ from crusher.feed_psd's");
+  const nlohmann::json wall = r.value("wall_time_s", nlohmann::json());
+  run.figures = {{"scene", r.value("scene", "")},
+                 {"feed", c.contains("bonded") ? "bonded agglomerates (Eq 6-15 sizes)" : "spheres"},
+                 {"feed_particles", c.value("feed_balls", nlohmann::json())},
+                 {"breakages", c.value("breakages", nlohmann::json())},
+                 {"p50_mm", orNull(numberOr(c, "p50_mm"))},
+                 {"p80_mm", orNull(numberOr(c, "p80_mm"))},
+                 {"throughput_tph", orNull(numberOr(c, "throughput_tph"))},
+                 {"power_W", orNull(numberOr(c, "power_W"))},
+                 {"chamber_empty", c.value("empty", nlohmann::json())},
+                 {"simulated_time_s", r.value("simulated_time_s", nlohmann::json())},
+                 {"wall_time_s", wall.is_object() ? wall.value("total", nlohmann::json()) : nlohmann::json()}};
+  return run;
+}
+
+/// A table cell: numbers to 6 digits, "" for null.
+std::string cell(const nlohmann::json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (!v.is_number()) return "";
+  std::ostringstream s;
+  s << std::setprecision(6) << v.get<double>();
+  return s.str();
+}
+
+}  // namespace
+
+int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::ostream& err) {
+  if (o.runs.empty()) {
+    err << "error: products: no run folder given\n";
+    return kExitBadInput;
+  }
+  if (!o.labels.empty() && o.labels.size() != o.runs.size()) {
+    err << "error: products: --label given " << o.labels.size() << " times for " << o.runs.size()
+        << " runs (allowed: one a run, in their order, or none)\n";
+    return kExitBadInput;
+  }
+  std::vector<ProductRun> runs;
+  for (std::size_t k = 0; k < o.runs.size(); ++k) {
+    const std::filesystem::path file = o.runs[k] / "results.json";
+    try {
+      runs.push_back(readRun(o.runs[k]));
+    } catch (const crusher::PsdInputError& e) {
+      err << "error: " << file.string() << ": " << e.what() << '\n';
+      return kExitBadInput;
+    }
+    std::string label = o.labels.empty() ? o.runs[k].filename().string() : o.labels[k];
+    if (label.empty()) label = o.runs[k].string();
+    runs.back().label = label;
+    if (runs.back().sieves != runs.front().sieves) {
+      err << "error: " << file.string() << ": crusher.psd: its sieves differ from those of "
+          << (o.runs.front() / "results.json").string() << " (allowed: runs on the same sieves)\n";
+      return kExitBadInput;
+    }
+  }
+  const std::vector<double>& sieves = runs.front().sieves;
+
+  // The table: figures, then the product's passing at each sieve.
+  std::ostringstream csv;
+  csv << "label,run";
+  const std::vector<std::string> columns{"scene",         "feed",           "feed_particles", "breakages",
+                                         "p50_mm",        "p80_mm",         "throughput_tph", "power_W",
+                                         "chamber_empty", "simulated_time_s", "wall_time_s"};
+  for (const std::string& c : columns) csv << ',' << c;
+  for (const double s : sieves) csv << ",passing_" << s << "mm";
+  csv << '\n';
+  nlohmann::json table = nlohmann::json::array();
+  for (const ProductRun& run : runs) {
+    csv << '"' << run.label << "\",\"" << run.dir.string() << '"';
+    for (const std::string& c : columns) csv << ',' << cell(run.figures[c]);
+    nlohmann::json row = run.figures;
+    row["label"] = run.label;
+    row["run"] = run.dir.string();
+    nlohmann::json psd = nlohmann::json::array(), feed = nlohmann::json::array();
+    for (std::size_t k = 0; k < sieves.size(); ++k) {
+      csv << ',' << run.passing[k];
+      psd.push_back({{"size_mm", sieves[k]}, {"passing", run.passing[k]}});
+      feed.push_back({{"size_mm", sieves[k]}, {"passing", run.feed_passing[k]}});
+    }
+    csv << '\n';
+    row["psd"] = psd;
+    row["feed_psd"] = feed;
+    table.push_back(row);
+  }
+
+  // The chart: each run's product (points and line) and its feed (line) in one
+  // colour; one feed curve when every run had the same feed.
+  PlotSpec spec = sieveChart("product size distribution of each run");
+  bool one_feed = true;
+  for (const ProductRun& run : runs) one_feed = one_feed && run.feed_passing == runs.front().feed_passing;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    PlotSeries product{runs[k].label, sieves, {}, PlotSeries::Style::LinePoints};
+    for (const double p : runs[k].passing) product.y.push_back(100 * p);
+    product.colour = static_cast<int>(k);
+    spec.series.push_back(product);
+  }
+  for (std::size_t k = 0; k < (one_feed ? 1 : runs.size()); ++k) {
+    PlotSeries feed{one_feed ? "feed" : "feed: " + runs[k].label, sieves, {}, PlotSeries::Style::Line};
+    for (const double p : runs[k].feed_passing) feed.y.push_back(100 * p);
+    feed.colour = one_feed ? static_cast<int>(runs.size()) : static_cast<int>(k);
+    spec.series.push_back(feed);
+  }
+  try {
+    std::filesystem::create_directories(o.out_dir);
+    detail::writeAtomically(o.out_dir / "products.csv", csv.str());
+    detail::writeAtomically(o.out_dir / "products.json", nlohmann::json({{"runs", table}}).dump(2) + "\n");
+    writePlot(spec, o.out_dir / "product_curves.png");
+  } catch (const std::exception& e) {
+    err << "error: products: " << e.what() << '\n';
+    return kExitFailed;
+  }
+  out << std::left << std::setw(28) << "run" << std::right << std::setw(10) << "P50_mm" << std::setw(10) << "P80_mm"
+      << std::setw(11) << "breakages" << std::setw(8) << "t/h" << std::setw(8) << "empty" << '\n';
+  for (const ProductRun& run : runs)
+    out << std::left << std::setw(28) << run.label << std::right << std::setw(10) << cell(run.figures["p50_mm"])
+        << std::setw(10) << cell(run.figures["p80_mm"]) << std::setw(11) << cell(run.figures["breakages"])
+        << std::setw(8) << cell(run.figures["throughput_tph"]) << std::setw(8) << cell(run.figures["chamber_empty"])
+        << '\n';
+  out << "wrote " << (o.out_dir / "products.csv").string() << ", products.json and product_curves.png\n";
+  return 0;
+}
+
+}  // namespace rocklab::experiments
