@@ -516,7 +516,7 @@ int sceneCommand(const CliArgs& a, const std::string& command) {
   const StopOnSignals stop_on_signals;
   detail::QuietLogBuffer quiet(std::cerr);
   std::ostream quiet_log(&quiet);
-  return runScene(scene, options, a.quiet ? quiet_log : std::cerr);
+  return runScene(std::move(scene), options, a.quiet ? quiet_log : std::cerr);
 }
 
 /// The command line parsed and run; `name` is set to the subcommand's name once known.

@@ -335,7 +335,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
       int code;
       {
         std::ofstream run_log(set_dir / "logs" / (r->name + ".log"));
-        code = runScene(scene, ro, run_log);
+        code = runScene(std::move(scene), ro, run_log);
       }
       writeExit(set_dir, r->name, code);
       finished(*r, code);

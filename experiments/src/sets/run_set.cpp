@@ -46,7 +46,7 @@ void runVariant(const SweepOptions& o, const std::filesystem::path& dir, Variant
   ro.progress = o.progress;
   ro.earlier_run = EarlierRun::Replace;  // a calibration run again into its folder: no old output stays
   std::ofstream run_log(dir / "run.log");
-  p.code = runScene(scene, ro, run_log);
+  p.code = runScene(std::move(scene), ro, run_log);
   p.results = readJsonFile(dir / "results.json");
   log << "  ";
   for (std::size_t k = 0; k < o.vary.size(); ++k) log << o.vary[k].first << " = " << p.values[k] << "  ";

@@ -39,6 +39,10 @@ struct RunOptions {
 
 /// Runs a loaded scene. Returns an ExitCode; writes messages to `log`.
 int runScene(const Scene& scene, const RunOptions& options, std::ostream& log);
+/// The same for a scene the run may take apart: once the World (and the experiment)
+/// hold the particles, the scene's own lists of spheres, clumps and bonds are freed
+/// (about 90 bytes a sphere for the rest of the run; the caller gets them back empty).
+int runScene(Scene&& scene, const RunOptions& options, std::ostream& log);
 
 /// Requests a clean stop of the running scene (called from the SIGINT, SIGTERM and SIGHUP handler).
 void requestStop();
