@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <ostream>
@@ -31,6 +30,7 @@
 #include "analysis/tracking_report.h"
 #include "camera/camera_calibration.h"
 #include "camera/camera_recorder.h"
+#include "common/atomic_file.h"
 #include "drivers/settle.h"
 #include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
@@ -729,7 +729,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
   if (!tracking.is_null()) r["tracking"] = tracking;
   // Column profile: the mean truth velocity, and the mean tracked one when tracked.
   nlohmann::json profile = nlohmann::json::array();
-  std::ofstream profile_csv(out_dir / "profile.csv");
+  std::ostringstream profile_csv;  // written whole (detail::writeAtomically), as every table below
   profile_csv << "column,distance_m,mean_truth_velocity_mps,mean_tracked_velocity_mps\n";
   for (std::size_t c = 0; c < e_.marker_columns.size(); ++c) {
     double sum = 0, sum_tracked = 0;
@@ -758,6 +758,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
     profile_csv << c + 1 << ',' << e_.marker_columns[c] << ',' << (n ? std::to_string(sum / n) : "")
                 << ',' << (n_tracked ? std::to_string(sum_tracked / n_tracked) : "") << '\n';
   }
+  detail::writeAtomically(out_dir / "profile.csv", profile_csv.str());
   r["profile"] = profile;
   r["chute"] = {{"inclination_deg", e_.inclination_deg},
                 {"gravity_tilt", e_.rotate_gravity ? "rotate" : "add"},
@@ -777,7 +778,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
 
   // CSV tables with units in the header, and the two plots.
   {
-    std::ofstream csv(out_dir / "markers.csv");
+    std::ostringstream csv;
     csv << "id,column,row,start_x_m,start_y_m,start_z_m,onset_time_s,travel_time_s,truth_velocity_"
            "mps,"
            "velocity_from_gate_mps\n";
@@ -785,9 +786,11 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
       csv << m.id << ',' << m.column << ',' << m.row << ',' << m.start.x() << ',' << m.start.y()
           << ',' << m.start.z() << ',' << m.onset_time << ',' << m.travel_time << ',' << m.velocity
           << ',' << m.velocity_from_gate << '\n';
-    std::ofstream d(out_dir / "discharge.csv");
+    detail::writeAtomically(out_dir / "markers.csv", csv.str());
+    std::ostringstream d;
     d << "time_after_gate_s,discharged_mass_kg\n";
     for (const auto& [t, m] : discharge_curve_) d << t << ',' << m << '\n';
+    detail::writeAtomically(out_dir / "discharge.csv", d.str());
   }
   if (flowed) {
     PlotSpec prof;
