@@ -453,3 +453,27 @@ TEST_CASE("a run that owns its scene frees the scene's particle lists and ends i
   CHECK(a["markers"] == b["markers"]);
   fs::remove_all(dir);
 }
+
+TEST_CASE("chute: the deposit ends when what the top plate keeps is at rest, or with settle_scope all when every ball is",
+          "[experiment]") {
+  // Nine spheres rest under the plate; a tenth falls from 2 m. Only the nine count
+  // by default: the deposit ends at settle_min_time and the plate deletes the tenth.
+  // With "all" it cannot end before the tenth has reached the base (0.64 s of fall).
+  const std::string path = std::string(ROCKLAB_SOURCE_DIR) + "/tests/experiments/scenes/settle-scope-chute.toml";
+  const json kept = runFor(path, {}, "settle-kept");
+  CHECK(kept["chute"]["settle_scope"] == "kept");
+  CHECK(kept["chute"]["deposit_settled"] == true);
+  CHECK(kept["chute"]["deposit_end_s"].get<double>() < 0.2);
+  CHECK(kept["chute"]["bodies_removed_by_top_plate"] == 1);
+  CHECK(kept["chute"]["discharged_bodies"] == 9);
+  const json all = runFor(path, {"experiment.settle_scope=\"all\""}, "settle-all");
+  CHECK(all["chute"]["settle_scope"] == "all");
+  CHECK(all["chute"]["deposit_end_s"].get<double>() > 0.6);
+  // A bad value names the key and what is allowed.
+  try {
+    loadScene(path, {"experiment.settle_scope=\"some\""});
+    FAIL("settle_scope = \"some\" was accepted");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("settle_scope") && Catch::Contains("kept"));
+  }
+}

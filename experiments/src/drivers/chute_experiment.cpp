@@ -140,7 +140,9 @@ class ChuteExperiment final : public Experiment {
     }
     if (step % every_ != 0) return true;
     if (phase_ == Phase::Deposit) {
-      if (!settle_.over(*world)) return true;
+      const bool only_kept = !e_.top_wall.empty() && e_.settle_scope == "kept";
+      if (!settle_.over(*world, only_kept ? cutByTop(world->particles(), topPlane(world->model())) : std::vector<bool>{}))
+        return true;
       endDeposit(world, ctx);
       return true;
     }
@@ -217,6 +219,27 @@ class ChuteExperiment final : public Experiment {
  private:
   enum class Phase { Start, Deposit, Tilt, Flow, Done };
 
+  /// The top plate's lower face: a point and the normal facing down into the channel.
+  struct TopPlane {
+    Vec3 point = Vec3::Zero(), normal = -Vec3::UnitZ();
+  };
+  TopPlane topPlane(const sim::Model& model) const {
+    const sim::Wall& top = model.walls[wallIndex(model, e_.top_wall)];
+    TopPlane plane{top.point, top.normal};
+    if (top.shape == sim::WallShape::Polygon) {
+      plane.normal = sim::polygonNormal(top.vertices);
+      plane.point = top.vertices[0];
+    }
+    if (plane.normal.z() > 0) plane.normal = -plane.normal;
+    return plane;
+  }
+  /// The balls the plate cuts (or that lie beyond it): deleted when it is placed (§d DEM 3).
+  static std::vector<bool> cutByTop(const sim::ParticleState& p, const TopPlane& top) {
+    std::vector<bool> cut(p.size(), false);
+    for (std::size_t i = 0; i < p.size(); ++i) cut[i] = top.normal.dot(p.position[i] - top.point) < p.radius[i];
+    return cut;
+  }
+
   // The model of each phase, from the time it began: the run's phase switches and
   // a restart (restoreState) make it the same way.
   void depositModel(sim::Model& m) const {
@@ -267,19 +290,11 @@ class ChuteExperiment final : public Experiment {
     // deposited bed, as in the study's zoned chute (§d DEM 3).
     std::vector<bool> remove;
     if (!e_.top_wall.empty()) {
-      const sim::Wall& top = world->model().walls[wallIndex(world->model(), e_.top_wall)];
-      Vec3 normal = top.normal, point = top.point;
-      if (top.shape == sim::WallShape::Polygon) {
-        normal = sim::polygonNormal(top.vertices);
-        point = top.vertices[0];
-      }
-      if (normal.z() > 0) normal = -normal;  // faces down, into the channel
-      has_top_ = std::abs(normal.z()) > 1e-9;
-      top_point_ = point;
-      top_normal_ = normal;
-      remove.assign(p.size(), false);
-      for (std::size_t i = 0; i < p.size(); ++i)
-        remove[i] = normal.dot(p.position[i] - point) < p.radius[i];
+      const TopPlane top = topPlane(world->model());
+      has_top_ = std::abs(top.normal.z()) > 1e-9;
+      top_point_ = top.point;
+      top_normal_ = top.normal;
+      remove = cutByTop(p, top);
     }
     // Bed height: 95th percentile of the ball tops (robust to a few loose balls).
     std::vector<double> tops;
@@ -766,6 +781,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"deposit_settled", settle_.settled()},
                 {"deposit_end_s", orNull(deposit_time_)},
                 {"deposit_max_speed_mps", settle_.maxSpeed()},
+                {"settle_scope", e_.top_wall.empty() ? "all" : e_.settle_scope},
                 {"bed_height_m", bed_height_},
                 {"bodies_removed_by_top_plate", removed_by_top_},
                 {"bodies", bodies_total_},
@@ -897,6 +913,7 @@ std::shared_ptr<ExperimentSettings> readChuteSettings(TableReader& t,
     t.fail("gravity_tilt", "\"add\" (g tan(angle) along the base) needs angles below 90 deg");
   e.gate_wall = wallKey("gate_wall", e.gate_wall);
   if (t.has("top_wall")) e.top_wall = wallKey("top_wall", "");
+  e.settle_scope = t.string("settle_scope", e.settle_scope, {"kept", "all"});
   e.temporary_walls = t.stringList("temporary_walls", names);
   e.tilt_steps = static_cast<std::uint64_t>(
       t.integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));

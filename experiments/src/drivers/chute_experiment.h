@@ -26,6 +26,10 @@ struct ChuteSettings final : ExperimentSettings {
   std::string gate_wall = "gate";            // wall removed to release the flow
   std::vector<std::string> temporary_walls;  // walls removed after deposition (zone separators)
   std::string top_wall;                // wall added after deposition; bodies cut by it are removed
+  // Whose speed ends the deposit (with a top_wall): "kept" = the balls the top plate
+  // keeps (those it cuts are deleted, so their rolling does not hold the deposit);
+  // "all" = every ball.
+  std::string settle_scope = "kept";
   std::uint64_t tilt_steps = 5000;     // steps at the test inclination with the gate closed
   std::vector<double> marker_columns;  // m from the outlet, column 1 first
   std::vector<double> marker_heights;  // m above the base, the same in every column; or...

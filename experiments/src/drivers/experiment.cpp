@@ -27,9 +27,10 @@ double bodyMass(const sim::ParticleState& p, const BodyRef& b) {
   return b.clump ? p.clumps.mass[b.index] : p.mass[b.index];
 }
 
-double maxBallSpeed(const sim::ParticleState& p) {
+double maxBallSpeed(const sim::ParticleState& p, const std::vector<bool>& skip) {
   double v2 = 0;
-  for (const auto& v : p.velocity) v2 = std::max(v2, v.squaredNorm());
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (skip.empty() || !skip[i]) v2 = std::max(v2, p.velocity[i].squaredNorm());
   return std::sqrt(v2);
 }
 

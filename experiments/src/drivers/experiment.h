@@ -78,8 +78,9 @@ std::unordered_map<std::uint64_t, BodyRef> indexBodies(const sim::ParticleState&
 /// Centre of mass and mass of a body.
 geometry::Vec3 bodyPosition(const sim::ParticleState& p, const BodyRef& b);
 double bodyMass(const sim::ParticleState& p, const BodyRef& b);
-/// Largest ball speed (members included, so spin counts too), m/s.
-double maxBallSpeed(const sim::ParticleState& p);
+/// Largest ball speed (members included, so spin counts too), m/s; balls with
+/// skip[i] (when skip is given) do not count.
+double maxBallSpeed(const sim::ParticleState& p, const std::vector<bool>& skip = {});
 /// Gravity of magnitude g tilted by `angle_deg` towards -x (the chute outlet):
 /// rotated (|g| kept) or with the study's additional component g tan(angle).
 geometry::Vec3 tiltedGravity(double g, double angle_deg, bool rotate);

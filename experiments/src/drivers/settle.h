@@ -17,8 +17,9 @@ class SettleDetector {
       : speed_limit_(s.speed), min_time_(s.min_time), max_time_(s.max_time) {}
 
   /// Call on a sample step: true once the deposit is over (settled, or out of time).
-  bool over(const sim::World& world) {
-    speed_ = maxBallSpeed(world.particles());
+  /// Balls with skip[i] (when given) do not count: the chute's top plate deletes them.
+  bool over(const sim::World& world, const std::vector<bool>& skip = {}) {
+    speed_ = maxBallSpeed(world.particles(), skip);
     const double t = world.time();
     if (t < min_time_) return false;
     settled_ = speed_ < speed_limit_;
