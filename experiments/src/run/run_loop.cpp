@@ -28,10 +28,13 @@ std::string clockText(double s) {
 /// Progress on stderr: a line every 2 s on a terminal (overwritten), every 15 s otherwise.
 class Progress {
  public:
-  Progress(bool enabled, std::uint64_t total_steps, double dt)
+  /// `first_step`: the step count the run starts from (a restart's is its checkpoint's),
+  /// so that steps/s and the ETA count only what this process stepped.
+  Progress(bool enabled, std::uint64_t total_steps, std::uint64_t first_step, double dt)
       : enabled_(enabled),
         tty_(isatty(STDERR_FILENO)),
         total_(total_steps),
+        first_(first_step),
         dt_(dt),
         start_(Clock::now()),
         last_(start_) {}
@@ -44,7 +47,7 @@ class Progress {
     if (seconds(last_, now) < (tty_ ? 2.0 : 15.0)) return;
     last_ = now;
     const double elapsed = seconds(start_, now);
-    const double rate = done / std::max(elapsed, 1e-9);
+    const double rate = static_cast<double>(done - std::min(done, first_)) / std::max(elapsed, 1e-9);
     const double eta = (total_ - done) / std::max(rate, 1e-9);
     std::ostringstream s;
     s << std::fixed << std::setprecision(4) << "t = " << done * dt_ << " / " << total_ * dt_
@@ -59,7 +62,7 @@ class Progress {
 
  private:
   bool enabled_, tty_;
-  std::uint64_t total_;
+  std::uint64_t total_, first_;
   double dt_;
   Clock::time_point start_, last_;
   bool printed_ = false;
@@ -106,7 +109,7 @@ class RunLoop {
         setup_(setup),
         world_(setup.world),
         context_{options.threads, &log},
-        progress_(options.progress, setup.total_steps, setup.dt) {}
+        progress_(options.progress, setup.total_steps, setup.world->stepCount(), setup.dt) {}
 
   RunRecord run() {
     record_.first_step = world_->stepCount();
