@@ -1,7 +1,6 @@
 #include "crusher/products_command.h"
 
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -31,15 +30,8 @@ double numberOr(const nlohmann::json& c, const char* key) {
 nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 ProductRun readRun(const std::filesystem::path& dir) {
-  std::ifstream in(dir / "results.json");
-  if (!in) throw crusher::PsdInputError("cannot read (a crusher run's folder holds it)");
-  nlohmann::json r;
-  try {
-    r = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw crusher::PsdInputError(std::string("not JSON: ") + e.what());
-  }
-  const nlohmann::json& c = crusher::needKey(r, "crusher", "results.json (not a crusher run)");
+  const nlohmann::json r = crusher::readCrusherResults(dir);
+  const nlohmann::json& c = r.at("crusher");
   ProductRun run;
   run.dir = dir;
   std::vector<double> feed_sieves;

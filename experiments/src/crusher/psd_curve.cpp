@@ -1,6 +1,21 @@
 #include "crusher/psd_curve.h"
 
+#include <fstream>
+
 namespace rocklab::experiments::crusher {
+
+nlohmann::json readCrusherResults(const std::filesystem::path& run_dir) {
+  std::ifstream in(run_dir / "results.json");
+  if (!in) throw PsdInputError("cannot read (a crusher run's folder holds it)");
+  nlohmann::json r;
+  try {
+    r = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw PsdInputError(std::string("not JSON: ") + e.what());
+  }
+  needKey(r, "crusher", "results.json (not a crusher run)");
+  return r;
+}
 
 const nlohmann::json& needKey(const nlohmann::json& j, const std::string& key, const std::string& where) {
   if (!j.is_object() || !j.contains(key)) throw PsdInputError(where + ": no key '" + key + "'");

@@ -3,6 +3,7 @@
 // (`rocklab whiten`, `rocklab products`): a key that must be there, and a sieve
 // curve (a list of {size_mm, passing}) checked row by row. A complaint is a
 // PsdInputError whose message names the key and what is allowed.
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,10 @@ namespace rocklab::experiments::crusher {
 struct PsdInputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// A finished crusher run's results.json (in `run_dir`), read and checked to hold a
+/// `crusher` block; PsdInputError when it cannot be read, is not JSON or has none.
+nlohmann::json readCrusherResults(const std::filesystem::path& run_dir);
 
 /// j[key], or PsdInputError "<where>: no key '<key>'".
 const nlohmann::json& needKey(const nlohmann::json& j, const std::string& key, const std::string& where);

@@ -1,6 +1,5 @@
 #include "crusher/whiten_command.h"
 
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -18,15 +17,8 @@ namespace rocklab::experiments {
 int runWhitenCommand(const WhitenCommandOptions& o, std::ostream& out, std::ostream& err) {
   const std::filesystem::path file = o.run_dir / "results.json";
   try {
-    std::ifstream in(file);
-    if (!in) throw crusher::PsdInputError("cannot read (a crusher run's folder holds it)");
-    nlohmann::json r;
-    try {
-      r = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-      throw crusher::PsdInputError(std::string("not JSON: ") + e.what());
-    }
-    const nlohmann::json& c = crusher::needKey(r, "crusher", "results.json (not a crusher run)");
+    const nlohmann::json r = crusher::readCrusherResults(o.run_dir);
+    const nlohmann::json& c = r.at("crusher");
     std::vector<double> sieves, feed_passing, sizes, product_passing;
     crusher::readSieveCurve(crusher::needKey(c, "feed_psd", "crusher"), "crusher.feed_psd", sieves, feed_passing);
     crusher::readSieveCurve(crusher::needKey(c, "psd", "crusher"), "crusher.psd", sizes, product_passing);
