@@ -240,6 +240,16 @@ TEST_CASE("render re-renders a stored run from another camera", "[cli]") {
   const fs::path movie = fs::exists(out / "top" / "top.mp4") ? out / "top" / "top.mp4" : out / "top" / "top.avi";
   REQUIRE(fs::exists(movie));
   CHECK(fs::file_size(movie) > 0);
+  // A camera's start_time and end_time pick the stored frames (every 0.001 s): those
+  // at 0.002 and 0.003 s.
+  std::ofstream(out / "window.toml") << "[[cameras]]\nname = \"window\"\nresolution = [64, 48]\nfov_deg = 60.0\n"
+                                        "eye = [0.0, 0.0, 1.5]\ntarget = [0.0, 0.0, 0.3]\nup = [1.0, 0.0, 0.0]\n"
+                                        "start_time = 0.0015\nend_time = 0.0035\nall_frames = true\nmovie = false\n";
+  REQUIRE(cli({"render", (out / "run.h5").string(), "--camera", (out / "window.toml").string(), "--out",
+               (out / "window").string()}) == 0);
+  int frames = 0;
+  for (const auto& f : fs::directory_iterator(out / "window" / "frames" / "window")) frames += f.path().extension() == ".png";
+  CHECK(frames == 2);
   // Bad input: an unknown camera key, a missing run file, a scene without cameras.
   std::ofstream(out / "bad.toml") << "[[cameras]]\nname = \"x\"\nfov_deg = 60.0\neye = [0, 0, 1]\ntarget = [0, 0, 0]\n"
                                      "up = [1, 0, 0]\nzoom = 2\n";

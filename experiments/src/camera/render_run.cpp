@@ -74,14 +74,18 @@ int renderRun(const RenderRunOptions& o, std::ostream& log) {
     }
     const std::filesystem::path out = o.out_dir.empty() ? o.run_file.parent_path() : o.out_dir;
     std::filesystem::create_directories(out);
+    // Every stored frame within each camera's start_time..end_time (its frame_rate
+    // does not thin them: the stored frames are what there is).
     std::vector<std::unique_ptr<CameraRecorder>> recorders;
-    for (CameraSettings c : cameras) {
-      c.start_time = 0.0;  // every stored frame, whatever the camera's own timing
+    std::vector<std::pair<double, double>> windows;  // s
+    for (const CameraSettings& c : cameras) {
       recorders.push_back(std::make_unique<CameraRecorder>(c, scene, out, log));
+      windows.emplace_back(c.start_time, c.end_time);
     }
     for (std::size_t k = 0; k < run.frameCount(); ++k) {
       const sim::Snapshot& s = run.frame(k);
-      for (auto& r : recorders) r->record(s, scene.model, markers);
+      for (std::size_t c = 0; c < recorders.size(); ++c)
+        if (s.time >= windows[c].first && s.time <= windows[c].second) recorders[c]->record(s, scene.model, markers);
     }
     nlohmann::json list = nlohmann::json::array();
     for (auto& r : recorders) r->finish(list);
