@@ -47,7 +47,7 @@ CameraRecorder::CameraRecorder(const CameraSettings& settings, const Scene& scen
 }
 
 bool CameraRecorder::due(double t) const {
-  if (t < settings_.start_time || t > settings_.end_time) return false;
+  if (!inWindow(t)) return false;
   // Frame k belongs to start + k / frame_rate; due once t reaches it.
   const double next = settings_.start_time + static_cast<double>(frames_) / settings_.camera.frameRate;
   return t >= next - 1e-12;

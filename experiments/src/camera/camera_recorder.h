@@ -27,6 +27,8 @@ class CameraRecorder {
                  std::ostream& log);
   /// True when a frame is due at simulated time t.
   bool due(double t) const;
+  /// True when t lies within the camera's start_time..end_time.
+  bool inWindow(double t) const { return t >= settings_.start_time && t <= settings_.end_time; }
   void record(const sim::Snapshot& s, const sim::Model& model, const std::unordered_set<std::uint64_t>& markers);
   /// Closes the movie; adds this camera's figures to `cameras` (a JSON array).
   void finish(nlohmann::json& cameras);

@@ -77,15 +77,11 @@ int renderRun(const RenderRunOptions& o, std::ostream& log) {
     // Every stored frame within each camera's start_time..end_time (its frame_rate
     // does not thin them: the stored frames are what there is).
     std::vector<std::unique_ptr<CameraRecorder>> recorders;
-    std::vector<std::pair<double, double>> windows;  // s
-    for (const CameraSettings& c : cameras) {
-      recorders.push_back(std::make_unique<CameraRecorder>(c, scene, out, log));
-      windows.emplace_back(c.start_time, c.end_time);
-    }
+    for (const CameraSettings& c : cameras) recorders.push_back(std::make_unique<CameraRecorder>(c, scene, out, log));
     for (std::size_t k = 0; k < run.frameCount(); ++k) {
       const sim::Snapshot& s = run.frame(k);
-      for (std::size_t c = 0; c < recorders.size(); ++c)
-        if (s.time >= windows[c].first && s.time <= windows[c].second) recorders[c]->record(s, scene.model, markers);
+      for (auto& r : recorders)
+        if (r->inWindow(s.time)) r->record(s, scene.model, markers);
     }
     nlohmann::json list = nlohmann::json::array();
     for (auto& r : recorders) r->finish(list);

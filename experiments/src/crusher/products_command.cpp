@@ -1,8 +1,6 @@
 #include "crusher/products_command.h"
 
-#include <cmath>
 #include <iomanip>
-#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -10,6 +8,7 @@
 #include "common/atomic_file.h"
 #include "crusher/psd_curve.h"
 #include "rocklab/experiments/run.h"
+#include "sets/run_set.h"
 
 namespace rocklab::experiments {
 
@@ -22,12 +21,10 @@ struct ProductRun {
   nlohmann::json figures;                             // the table's row
 };
 
-/// A number of `c` at `key`, NaN when it is missing or null (a run with no product).
-double numberOr(const nlohmann::json& c, const char* key) {
-  return c.contains(key) && c[key].is_number() ? c[key].get<double>() : std::numeric_limits<double>::quiet_NaN();
+/// The number of `c` at `key`, null when it is missing or not a number (a run with no product).
+nlohmann::json numberOrNull(const nlohmann::json& c, const char* key) {
+  return c.contains(key) && c[key].is_number() ? c[key] : nlohmann::json(nullptr);
 }
-
-nlohmann::json orNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 ProductRun readRun(const std::filesystem::path& dir) {
   const nlohmann::json r = crusher::readCrusherResults(dir);
@@ -44,24 +41,14 @@ ProductRun readRun(const std::filesystem::path& dir) {
                  {"feed", c.contains("bonded") ? "bonded agglomerates (Eq 6-15 sizes)" : "spheres"},
                  {"feed_particles", c.value("feed_balls", nlohmann::json())},
                  {"breakages", c.value("breakages", nlohmann::json())},
-                 {"p50_mm", orNull(numberOr(c, "p50_mm"))},
-                 {"p80_mm", orNull(numberOr(c, "p80_mm"))},
-                 {"throughput_tph", orNull(numberOr(c, "throughput_tph"))},
-                 {"power_W", orNull(numberOr(c, "power_W"))},
+                 {"p50_mm", numberOrNull(c, "p50_mm")},
+                 {"p80_mm", numberOrNull(c, "p80_mm")},
+                 {"throughput_tph", numberOrNull(c, "throughput_tph")},
+                 {"power_W", numberOrNull(c, "power_W")},
                  {"chamber_empty", c.value("empty", nlohmann::json())},
                  {"simulated_time_s", r.value("simulated_time_s", nlohmann::json())},
                  {"wall_time_s", wall.is_object() ? wall.value("total", nlohmann::json()) : nlohmann::json()}};
   return run;
-}
-
-/// A table cell: numbers to 6 digits, "" for null.
-std::string cell(const nlohmann::json& v) {
-  if (v.is_string()) return v.get<std::string>();
-  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
-  if (!v.is_number()) return "";
-  std::ostringstream s;
-  s << std::setprecision(6) << v.get<double>();
-  return s.str();
 }
 
 }  // namespace
@@ -108,7 +95,7 @@ int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::
   nlohmann::json table = nlohmann::json::array();
   for (const ProductRun& run : runs) {
     csv << '"' << run.label << "\",\"" << run.dir.string() << '"';
-    for (const std::string& c : columns) csv << ',' << cell(run.figures[c]);
+    for (const std::string& c : columns) csv << ',' << detail::cell(run.figures[c]);
     nlohmann::json row = run.figures;
     row["label"] = run.label;
     row["run"] = run.dir.string();
@@ -153,9 +140,9 @@ int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::
   out << std::left << std::setw(28) << "run" << std::right << std::setw(10) << "P50_mm" << std::setw(10) << "P80_mm"
       << std::setw(11) << "breakages" << std::setw(8) << "t/h" << std::setw(8) << "empty" << '\n';
   for (const ProductRun& run : runs)
-    out << std::left << std::setw(28) << run.label << std::right << std::setw(10) << cell(run.figures["p50_mm"])
-        << std::setw(10) << cell(run.figures["p80_mm"]) << std::setw(11) << cell(run.figures["breakages"])
-        << std::setw(8) << cell(run.figures["throughput_tph"]) << std::setw(8) << cell(run.figures["chamber_empty"])
+    out << std::left << std::setw(28) << run.label << std::right << std::setw(10) << detail::cell(run.figures["p50_mm"])
+        << std::setw(10) << detail::cell(run.figures["p80_mm"]) << std::setw(11) << detail::cell(run.figures["breakages"])
+        << std::setw(8) << detail::cell(run.figures["throughput_tph"]) << std::setw(8) << detail::cell(run.figures["chamber_empty"])
         << '\n';
   out << "wrote " << (o.out_dir / "products.csv").string() << ", products.json and product_curves.png\n";
   return 0;
