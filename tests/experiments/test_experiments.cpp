@@ -349,7 +349,7 @@ TEST_CASE("zoned chute: the top plate cuts the deposited bed - what reached it g
   CHECK(after == 0);
 }
 
-TEST_CASE("zoned chute: stopped in its deposit or in its flow and restarted, it ends as the straight run, bit for bit",
+TEST_CASE("zoned chute: stopped in its deposit, at its end (stop_after) or in its flow and restarted, it ends as the straight run, bit for bit",
           "[experiment][restart]") {
   // The driver saves its phase, the deposit's and the gate's times, the markers and
   // the discharge so far; a restart rebuilds the model of that phase (gravity, the
@@ -395,6 +395,45 @@ TEST_CASE("zoned chute: stopped in its deposit or in its flow and restarted, it 
       CHECK(restarted["chute"][key] == straight["chute"][key]);
     CHECK(test::slurp(dir / second / "discharge.csv") == test::slurp(dir / "straight" / "discharge.csv"));
   }
+  // Stopped where its deposit is over (experiment.stop_after), before the plate is
+  // placed: the checkpoint is the state the straight run placed its plate into, so a
+  // sweep of plates restarted from it holds the straight run bit for bit, and a lower
+  // plate (CSS 40 mm) cuts more of the same deposit.
+  o.push_back("experiment.stop_after=\"deposit\"");
+  // Without its checkpoint such a run would be lost: refused, naming both keys.
+  try {
+    loadScene(kAssets + "zoned-chute.toml", {"experiment.stop_after=\"deposit\""});
+    FAIL("stop_after = \"deposit\" was accepted without output.checkpoint");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("experiment.stop_after") && Catch::Contains("output.checkpoint = true"));
+  }
+  REQUIRE(run("deposit", "") == 0);
+  const json deposit = results("deposit");
+  CHECK(deposit["chute"]["stopped_after_deposit"] == true);
+  CHECK(deposit["chute"]["deposit_end_s"] == straight["chute"]["deposit_end_s"]);
+  CHECK(deposit["chute"]["gate_open_s"].is_null());
+  REQUIRE(test::cli({"sweep", (dir / "deposit" / "checkpoint.h5").string(), "--vary",
+                     "walls.top.corner=[0,0,0.05],[0,0,0.04]", "--jobs", "0", "--threads", "2", "--quiet", "--out",
+                     (dir / "plates").string(), "--set", "scene.end_time=8.0"}) == 0);
+  CHECK_THAT(test::slurp(dir / "plates" / "runs.txt"), Catch::Contains(" restart "));  // each line a restart
+  std::vector<json> plates;
+  for (const auto& e : fs::directory_iterator(dir / "plates" / "runs")) {
+    std::ifstream in(e.path() / "results.json");
+    plates.push_back(json::parse(in));
+  }
+  REQUIRE(plates.size() == 2);
+  std::sort(plates.begin(), plates.end(), [](const json& a, const json& b) {
+    return a["chute"]["bodies"].get<int>() > b["chute"]["bodies"].get<int>();
+  });
+  const json& css50 = plates[0];
+  const json& css40 = plates[1];
+  CHECK(css50["state_hash"] == straight["state_hash"]);
+  CHECK(css50["clearance_time_s"] == straight["clearance_time_s"]);
+  CHECK(css50["markers"] == straight["markers"]);
+  CHECK(css50["chute"]["stopped_after_deposit"] == false);
+  CHECK(css40["chute"]["bodies_removed_by_top_plate"].get<int>() > straight["chute"]["bodies_removed_by_top_plate"].get<int>());
+  CHECK(css40["chute"]["deposit_end_s"] == straight["chute"]["deposit_end_s"]);
+  CHECK(css40["state_hash"] != straight["state_hash"]);
   fs::remove_all(dir);
 }
 

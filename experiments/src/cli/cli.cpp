@@ -236,7 +236,10 @@ void applySetOptions(const CliArgs& a, SweepOptions& so) {
 }
 
 void addSweepOptions(CLI::App* c, CliArgs& a) {
-  c->add_option("scene", a.scene_arg, "Scene TOML file or built-in name")->required();
+  c->add_option("scene", a.scene_arg,
+                "Scene TOML file or built-in name, or a checkpoint.h5 that every run restarts from (e.g. a chute "
+                "deposit run with experiment.stop_after = \"deposit\")")
+      ->required();
   c->add_option("--vary", a.vary, "key=a,b,c: values to run (TOML values, as for --set)")->required();
   addRunOptions(c, a);
 }
@@ -246,13 +249,14 @@ void addCommands(CLI::App& app, CliArgs& a) {
   auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
   run->add_option("scene", a.scene_arg, "Scene TOML file or built-in name (see `rocklab list`)")->required();
   addRunOptions(run, a);
-  run->add_flag("--skip-complete", a.skip_complete,
-                "Do nothing when --out already holds a completed run (results.json status \"completed\")");
   auto* demo = app.add_subcommand("demo", "Run the default demo scene end to end");
   addRunOptions(demo, a);
   auto* restart = app.add_subcommand("restart", "Continue a run from its checkpoint.h5, bit for bit");
   restart->add_option("checkpoint", a.checkpoint_arg, "checkpoint.h5 written by an earlier run")->required();
   addRunOptions(restart, a);
+  for (CLI::App* c : {run, restart})  // a set's run lines (runs.txt) skip what is done
+    c->add_flag("--skip-complete", a.skip_complete,
+                "Do nothing when --out already holds a completed run (results.json status \"completed\")");
   for (CLI::App* c : {run, demo, restart})
     c->add_flag("--overwrite", a.overwrite,
                 "Replace an earlier run in --out (its files are removed first); without it such a folder is "

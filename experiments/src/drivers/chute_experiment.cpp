@@ -138,11 +138,21 @@ class ChuteExperiment final : public Experiment {
       openGate(world, ctx);
       return true;
     }
+    if (phase_ == Phase::Deposit && deposit_over_) {  // restarted from a run that stopped after its deposit
+      endDeposit(world, ctx);
+      return true;
+    }
     if (step % every_ != 0) return true;
     if (phase_ == Phase::Deposit) {
       const bool only_kept = !e_.top_wall.empty() && e_.settle_scope == "kept";
       if (!settle_.over(*world, only_kept ? cutByTop(world->particles(), topPlane(world->model())) : std::vector<bool>{}))
         return true;
+      if (e_.stop_after == "deposit") {  // the state a restart places its own top plate into
+        deposit_over_ = true;
+        deposit_time_ = world->time();
+        bed_height_ = bedHeight(world->particles());
+        return false;
+      }
       endDeposit(world, ctx);
       return true;
     }
@@ -155,7 +165,7 @@ class ChuteExperiment final : public Experiment {
     switch (phase_) {
       case Phase::Start:
       case Phase::Deposit:
-        s << "deposit, max speed " << settle_.maxSpeed() << " m/s";
+        s << (deposit_over_ ? "deposit over" : "deposit") << ", max speed " << settle_.maxSpeed() << " m/s";
         break;
       case Phase::Tilt:
         s << "tilt";
@@ -181,6 +191,7 @@ class ChuteExperiment final : public Experiment {
   }
 
   bool restartable() const override { return true; }
+  bool endsBeforeStep() const override { return phase_ == Phase::Deposit && deposit_over_; }
 
   nlohmann::json saveState() const override {
     nlohmann::json j;
@@ -190,6 +201,7 @@ class ChuteExperiment final : public Experiment {
     j["discharged"] = discharged;
     j["top_point"] = asArray(top_point_);
     j["top_normal"] = asArray(top_normal_);
+    j["deposit_over"] = deposit_over_;
     return j;
   }
 
@@ -202,6 +214,7 @@ class ChuteExperiment final : public Experiment {
     discharged_ = {discharged.begin(), discharged.end()};
     top_point_ = asVec3(j.at("top_point"));
     top_normal_ = asVec3(j.at("top_normal"));
+    deposit_over_ = j.value("deposit_over", false);  // absent in checkpoints before stop_after
     if (phase_ < Phase::Start || phase_ > Phase::Done)
       throw std::invalid_argument("phase " + std::to_string(static_cast<int>(phase_)) + " (allowed: 0 to 4)");
     if (every_ == 0) throw std::invalid_argument("sample every 0 steps (allowed: at least 1)");
@@ -282,6 +295,15 @@ class ChuteExperiment final : public Experiment {
     f("tracking_error", self.tracking_error_);
   }
 
+  /// 95th percentile of the ball tops (robust to a few loose balls), m.
+  static double bedHeight(const sim::ParticleState& p) {
+    std::vector<double> tops;
+    for (std::size_t i = 0; i < p.size(); ++i) tops.push_back(p.position[i].z() + p.radius[i]);
+    if (tops.empty()) return 0.0;
+    std::sort(tops.begin(), tops.end());
+    return tops[static_cast<std::size_t>(0.95 * static_cast<double>(tops.size() - 1))];
+  }
+
   void endDeposit(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
     deposit_time_ = t;
@@ -296,13 +318,7 @@ class ChuteExperiment final : public Experiment {
       top_normal_ = top.normal;
       remove = cutByTop(p, top);
     }
-    // Bed height: 95th percentile of the ball tops (robust to a few loose balls).
-    std::vector<double> tops;
-    for (std::size_t i = 0; i < p.size(); ++i) tops.push_back(p.position[i].z() + p.radius[i]);
-    if (!tops.empty()) {
-      std::sort(tops.begin(), tops.end());
-      bed_height_ = tops[static_cast<std::size_t>(0.95 * static_cast<double>(tops.size() - 1))];
-    }
+    bed_height_ = bedHeight(p);
     switchPhase(
         world, ctx, [&](sim::Model& m) { testModel(m, t); }, remove);
     bodies_ = indexBodies(world->particles());
@@ -551,6 +567,7 @@ class ChuteExperiment final : public Experiment {
   double discharged_mass_ = 0;
   std::vector<std::pair<double, double>> discharge_curve_;  // (s after gate opening, kg)
   int checks_since_removal_ = 0;
+  bool deposit_over_ = false;  // stopped after the deposit (stop_after), the top plate not yet placed
   bool restored_ = false;  // by restoreState: bodies_ is made again from the World at the next advance
   std::unique_ptr<MarkerTracking> tracking_;
   MarkerTruth truth_;  // marker centres at every sample from the gate opening (tracking report only)
@@ -782,6 +799,8 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"deposit_end_s", orNull(deposit_time_)},
                 {"deposit_max_speed_mps", settle_.maxSpeed()},
                 {"settle_scope", e_.top_wall.empty() ? "all" : e_.settle_scope},
+                {"stop_after", e_.stop_after},
+                {"stopped_after_deposit", phase_ == Phase::Deposit && deposit_over_},
                 {"bed_height_m", bed_height_},
                 {"bodies_removed_by_top_plate", removed_by_top_},
                 {"bodies", bodies_total_},
@@ -870,6 +889,13 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
       << " s, bed " << bed_height_ * 1e3 << " mm, " << bodies_total_ << " bodies";
   if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";
+  if (phase_ == Phase::Deposit && deposit_over_) {
+    log << "chute: stopped after the deposit (experiment.stop_after = \"deposit\"): restart from "
+        << (out_dir / "checkpoint.h5").string()
+        << " with each case's top plate (rocklab restart CHECKPOINT --set walls." << (e_.top_wall.empty() ? "NAME" : e_.top_wall)
+        << ".angle_deg=..., or rocklab sweep CHECKPOINT --vary ...)\n";
+    return;
+  }
   if (!flowed) {
     log << "chute: the gate never opened (the run ended first: raise scene.end_time)\n";
     return;
@@ -914,6 +940,8 @@ std::shared_ptr<ExperimentSettings> readChuteSettings(TableReader& t,
   e.gate_wall = wallKey("gate_wall", e.gate_wall);
   if (t.has("top_wall")) e.top_wall = wallKey("top_wall", "");
   e.settle_scope = t.string("settle_scope", e.settle_scope, {"kept", "all"});
+  e.stop_after = t.string("stop_after", e.stop_after, {"none", "deposit"});
+  if (e.stop_after != "none") e.needs_checkpoint = "stop_after";
   e.temporary_walls = t.stringList("temporary_walls", names);
   e.tilt_steps = static_cast<std::uint64_t>(
       t.integer("tilt_steps", static_cast<std::int64_t>(e.tilt_steps), Range::nonNegative()));

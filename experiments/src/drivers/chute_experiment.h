@@ -30,6 +30,10 @@ struct ChuteSettings final : ExperimentSettings {
   // keeps (those it cuts are deleted, so their rolling does not hold the deposit);
   // "all" = every ball.
   std::string settle_scope = "kept";
+  // "deposit": the run ends where the deposit is over, before the top plate is
+  // placed, so that one deposit (its checkpoint) serves every plate of a study
+  // (`rocklab sweep CHECKPOINT --vary walls.top...`); "none": the whole test.
+  std::string stop_after = "none";
   std::uint64_t tilt_steps = 5000;     // steps at the test inclination with the gate closed
   std::vector<double> marker_columns;  // m from the outlet, column 1 first
   std::vector<double> marker_heights;  // m above the base, the same in every column; or...

@@ -47,6 +47,11 @@ class Experiment {
   /// before stepping, so a restart advances this step again, as an uninterrupted
   /// run did.
   virtual bool advanceUndone() const { return false; }
+  /// True when the advance() that returned false ended the experiment at a state
+  /// to restart from (a chute's settled deposit, experiment.stop_after): the run
+  /// stops before stepping, so its last checkpoint is that state and a restart
+  /// goes on from it as the straight run did.
+  virtual bool endsBeforeStep() const { return false; }
   /// Restart (`rocklab restart`): whether the driver saves its own state in
   /// checkpoint.h5 and goes on from it; a restart of one that cannot is refused.
   virtual bool restartable() const { return false; }

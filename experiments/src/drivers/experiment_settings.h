@@ -18,6 +18,9 @@ using detail::TableReader;
 struct ExperimentSettings {
   virtual ~ExperimentSettings() = default;
   double sample_interval = 0.002;  // s between the driver's samples (the lab filmed at 500 fps)
+  // The key of [experiment] whose value makes a run useless without its checkpoint
+  // (a chute's stop_after); "" = none. The scene reader then asks for output.checkpoint.
+  std::string needs_checkpoint;
 };
 
 /// The settings of `scene`'s experiment as its driver's type (the registry pairs

@@ -153,6 +153,7 @@ class RunLoop {
         stopWith("interrupted", "", kExitInterrupted);
         return false;
       }
+      if (record_.experiment_over && experiment->endsBeforeStep()) return false;
     }
     chooseObservations();
     record_.ball_steps += world_->particles().size();

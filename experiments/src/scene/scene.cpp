@@ -4,6 +4,7 @@
 #include <map>
 #include <sstream>
 
+#include "drivers/experiment_settings.h"
 #include "scene/scene_internal.h"
 
 #ifndef ROCKLAB_ASSET_DIR
@@ -34,6 +35,10 @@ Scene readScene(const toml::table& root_table, const std::filesystem::path& base
   detail::readCameras(root, scene.cameras);
   detail::readExperiment(root, scene);
   detail::readOutput(root, scene.run);
+  if (scene.experiment && !scene.experiment->needs_checkpoint.empty() && !scene.run.checkpoint)
+    root.table("experiment")
+        ->fail(scene.experiment->needs_checkpoint,
+               "needs output.checkpoint = true (the run ends there so that its checkpoint.h5 is restarted from)");
   root.finish();
   return scene;
 }

@@ -279,6 +279,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.chute", "gate_wall", "", "Wall removed to release the flow.", "a wall name"},
       {"experiment.chute", "top_wall", "", "Wall added after deposition (the zoned chute's top plate); bodies it cuts are removed.", "a wall name", "none"},
       {"experiment.chute", "settle_scope", "", "Whose speed ends the deposit with a top_wall: the balls the plate keeps (those it cuts are deleted, so their rolling does not hold the deposit) or every ball.", "\"kept\", \"all\"", "\"kept\""},
+      {"experiment.chute", "stop_after", "", "\"deposit\": the run ends where the deposit is over, before the top plate is placed (needs output.checkpoint = true), so that one deposit serves every plate of a study: rocklab restart CHECKPOINT --set walls.top..., or rocklab sweep CHECKPOINT --vary walls.top...; a restart goes on to the test. \"none\": the whole test.", "\"none\", \"deposit\"", "\"none\""},
       {"experiment.chute", "temporary_walls", "", "Walls removed after deposition (zone separators).", "wall names"},
       {"experiment.chute", "tilt_steps", "", "Steps at the test inclination with the gate closed."},
       {"experiment.chute", "marker_columns", "m", "Distances of the marker columns from the outlet, column 1 first."},

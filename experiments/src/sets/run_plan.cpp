@@ -157,7 +157,7 @@ std::vector<PlannedRun> planRuns(const SweepOptions& o) {
       seed_varied = seed_varied || o.vary[k].first == "scene.seed";
     }
     try {
-      const Scene scene = loadScene(resolveScene(o.scene), r.overrides);
+      const Scene scene = loadSetScene(o.scene, r.overrides);
       // The seed in the line: each run is reproducible alone, whatever the file says later.
       if (!seed_varied) r.overrides.push_back("scene.seed=" + std::to_string(scene.run.seed));
     } catch (const SceneError& e) {
@@ -169,7 +169,9 @@ std::vector<PlannedRun> planRuns(const SweepOptions& o) {
 }
 
 std::vector<std::string> runArguments(const fs::path& set_dir, const std::string& scene_path, const PlannedRun& run) {
-  std::vector<std::string> args = {selfExecutable().string(), "run",    scene_path,        "--out",
+  // A checkpoint source: each run restarts from it (`rocklab restart`), with its own --set.
+  const std::string command = restartsFrom(scene_path) ? "restart" : "run";
+  std::vector<std::string> args = {selfExecutable().string(), command,  scene_path,        "--out",
                                    (fs::absolute(set_dir) / "runs" / run.name).string(), "--threads",
                                    "1",          "--quiet", "--skip-complete", "--overwrite"};
   for (const std::string& s : run.overrides) {
@@ -192,7 +194,7 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
                     const json& what) {
   fs::create_directories(set_dir / "logs");
   const fs::path dir = fs::absolute(set_dir);
-  const std::string scene_path = fs::absolute(resolveScene(o.scene)).string();
+  const std::string scene_path = sourcePath(o.scene).string();
   json vary = json::array();
   for (const auto& [key, values] : o.vary) vary.push_back({{"key", key}, {"values", values}});
   json list = json::array();
@@ -326,12 +328,9 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
 
   if (jobs == 0) {  // in this process, one after the other, all threads each
     for (const PlannedRun* r : todo) {
-      Scene scene = loadScene(resolveScene(o.scene), r->overrides);
-      RunOptions ro;
-      ro.out_dir = set_dir / "runs" / r->name;
-      ro.threads = o.threads;
-      ro.progress = o.progress;
-      ro.earlier_run = EarlierRun::Replace;  // what an interrupted attempt left (a complete run is skipped above)
+      Scene scene = loadSetScene(o.scene, r->overrides);
+      // Replace: what an interrupted attempt left (a complete run is skipped above).
+      const RunOptions ro = setRunOptions(o, set_dir / "runs" / r->name);
       int code;
       {
         std::ofstream run_log(set_dir / "logs" / (r->name + ".log"));
@@ -345,7 +344,7 @@ int executeRuns(const fs::path& set_dir, const SweepOptions& o, const std::vecto
   }
 
   // A pool of `jobs` processes, each one run of one thread: the lines of runs.txt.
-  const std::string scene_path = fs::absolute(resolveScene(o.scene)).string();
+  const std::string scene_path = sourcePath(o.scene).string();
   std::map<pid_t, const PlannedRun*> running;
   std::size_t next = 0;
   auto last_line = std::chrono::steady_clock::now();

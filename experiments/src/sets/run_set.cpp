@@ -11,6 +11,7 @@
 
 #include "common/atomic_file.h"
 #include "common/json_text.h"
+#include "rocklab/sim/output/checkpoint.h"
 
 namespace rocklab::experiments::detail {
 
@@ -31,20 +32,44 @@ std::vector<Variant> expandVariants(const SweepOptions& o) {
   return variants;
 }
 
+bool restartsFrom(const std::string& source) { return std::filesystem::path(source).extension() == ".h5"; }
+
+Scene loadSetScene(const std::string& source, const std::vector<std::string>& overrides) {
+  if (!restartsFrom(source)) return loadScene(resolveScene(source), overrides);
+  try {
+    const sim::output::Checkpoint cp = sim::output::readCheckpoint(source);
+    Scene scene = loadSceneText(cp.scene_text, source + ":/scene", overrides, std::filesystem::path(source).parent_path());
+    scene.source = source;
+    return scene;
+  } catch (const sim::output::CheckpointError& e) {
+    throw SceneError(e.what());
+  }
+}
+
+std::filesystem::path sourcePath(const std::string& source) {
+  return std::filesystem::absolute(restartsFrom(source) ? std::filesystem::path(source) : resolveScene(source));
+}
+
+RunOptions setRunOptions(const SweepOptions& o, const std::filesystem::path& dir) {
+  RunOptions ro;
+  ro.out_dir = dir;
+  ro.threads = o.threads;
+  ro.progress = o.progress;
+  ro.earlier_run = EarlierRun::Replace;  // a run again into its folder: no old output stays
+  if (restartsFrom(o.scene)) ro.restart = o.scene;
+  return ro;
+}
+
 Scene sceneFor(const SweepOptions& o, const std::vector<std::string>& values) {
   std::vector<std::string> overrides = o.overrides;
   for (std::size_t k = 0; k < o.vary.size(); ++k) overrides.push_back(o.vary[k].first + "=" + values[k]);
-  return loadScene(resolveScene(o.scene), overrides);
+  return loadSetScene(o.scene, overrides);
 }
 
 void runVariant(const SweepOptions& o, const std::filesystem::path& dir, Variant& p, std::ostream& log) {
   Scene scene = sceneFor(o, p.values);
   std::filesystem::create_directories(dir);
-  RunOptions ro;
-  ro.out_dir = dir;
-  ro.threads = o.threads;
-  ro.progress = o.progress;
-  ro.earlier_run = EarlierRun::Replace;  // a calibration run again into its folder: no old output stays
+  const RunOptions ro = setRunOptions(o, dir);
   std::ofstream run_log(dir / "run.log");
   p.code = runScene(std::move(scene), ro, run_log);
   p.results = readJsonFile(dir / "results.json");

@@ -24,6 +24,16 @@ struct Variant {
 
 /// Every combination of the varied values, the first key slowest.
 std::vector<Variant> expandVariants(const SweepOptions& o);
+/// True when a set's source is a checkpoint.h5: each of its runs restarts from it
+/// (`rocklab sweep DEPOSIT/checkpoint.h5 --vary ...`), with the scene it was run with.
+bool restartsFrom(const std::string& source);
+/// The scene of a set's source (file, built-in name, or checkpoint: the scene text
+/// it carries) with `overrides`; throws SceneError, a damaged checkpoint included.
+Scene loadSetScene(const std::string& source, const std::vector<std::string>& overrides);
+/// The absolute path of a set's source, as its run lines name it.
+std::filesystem::path sourcePath(const std::string& source);
+/// RunOptions of one run of a set into `dir` (the restart from a checkpoint source).
+RunOptions setRunOptions(const SweepOptions& o, const std::filesystem::path& dir);
 /// Loads the scene with the fixed and the varied assignments (throws SceneError).
 Scene sceneFor(const SweepOptions& o, const std::vector<std::string>& values);
 /// Runs one variant into dir (its log in dir/run.log); fills v.results and v.code.

@@ -206,7 +206,8 @@ int collectSet(const std::filesystem::path& dir, std::ostream& log) {
   const std::vector<Variant> done = inspectRuns(dir, plan.runs);
   std::size_t complete = 0, failed = 0, missing = 0;
   for (const Variant& v : done) (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
-  const std::string name = std::filesystem::path(o.scene).stem().string();
+  const std::filesystem::path source(o.scene);  // a checkpoint is named by its run's folder
+  const std::string name = (restartsFrom(o.scene) ? source.parent_path().filename() : source.stem()).string();
   log << "collect " << plan.kind << " of " << name << ": " << complete << " complete, " << failed << " failed, "
       << missing << " missing of " << plan.runs.size() << " runs\n";
   if (plan.kind == "sweep") return reportSweep(dir, o, plan.metrics, done, name, log);
@@ -306,7 +307,7 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
     return kExitFailed;
   }
   log << "calibrate: " << key << " = " << cell(estimate) << " gives " << c.target_metric << " = " << c.target << " ("
-      << how << ")\n  check it: rocklab run " << o.scene << " --set " << key << "=" << cell(estimate) << "\n";
+      << how << ")\n  check it: rocklab " << (restartsFrom(o.scene) ? "restart " : "run ") << o.scene << " --set " << key << "=" << cell(estimate) << "\n";
   return kExitOk;
 }
 
