@@ -434,6 +434,32 @@ TEST_CASE("zoned chute: stopped in its deposit, at its end (stop_after) or in it
   CHECK(css40["chute"]["bodies_removed_by_top_plate"].get<int>() > straight["chute"]["bodies_removed_by_top_plate"].get<int>());
   CHECK(css40["chute"]["deposit_end_s"] == straight["chute"]["deposit_end_s"]);
   CHECK(css40["state_hash"] != straight["state_hash"]);
+  // The sweep's table keeps a vary value with commas in one cell.
+  CHECK_THAT(test::slurp(dir / "plates" / "sweep.csv"), Catch::Contains("\n\"[0,0,0.05]\","));
+  // `rocklab profiles`: the two plates' markers side by side, the column means as each run reported them.
+  std::vector<std::string> profile_args{"profiles"};
+  for (const auto& e : fs::directory_iterator(dir / "plates" / "runs")) profile_args.push_back(e.path().string());
+  profile_args.insert(profile_args.end(), {"--out", (dir / "profiles").string()});
+  REQUIRE(test::cli(profile_args) == 0);
+  std::ifstream pj(dir / "profiles" / "profiles.json");
+  const json profiles = json::parse(pj);
+  REQUIRE(profiles["runs"].size() == 2);
+  for (const json& row : profiles["runs"]) {
+    std::ifstream in(fs::path(row["run"].get<std::string>()) / "results.json");
+    const json r = json::parse(in);
+    CHECK(row["clearance_time_s"] == r["clearance_time_s"]);
+    REQUIRE(row["columns"].size() == r["profile"].size());
+    for (std::size_t c = 0; c < r["profile"].size(); ++c)
+      CHECK(row["columns"][c]["mean_truth_velocity_mps"] == r["profile"][c]["mean_truth_velocity_mps"]);
+  }
+  const std::string rows = test::slurp(dir / "profiles" / "profiles.csv");
+  CHECK(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')) ==
+        1 + css50["markers"].size() + css40["markers"].size());
+  for (const char* png : {"profile_column_1.png", "profile_column_3.png", "discharge.png"})
+    CHECK(fs::file_size(dir / "profiles" / png) > 1000);
+  // Not a chute run: exit 2, naming the file.
+  CHECK(test::cli({"profiles", (dir / "plates").string(), "--out", (dir / "bad").string()}) == 2);
+  CHECK_FALSE(fs::exists(dir / "bad"));
   fs::remove_all(dir);
 }
 

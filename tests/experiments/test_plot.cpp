@@ -15,6 +15,8 @@
 
 #include "analysis/plot.h"
 #include "analysis/plot_internal.h"
+#include "analysis/sweep_table.h"
+#include "common/csv.h"
 
 using namespace rocklab::experiments;
 using Catch::Contains;
@@ -170,4 +172,26 @@ TEST_CASE("without gnuplot the built-in plotter draws the PNG (no SVG) - a faili
   CHECK_THROWS_WITH(writePlot(spec, dir / "q.png"), Contains((dir / "q.png").string()) && Contains("gnuplot (false) failed"));
   CHECK_FALSE(fs::exists(dir / "q.png"));
   CHECK_FALSE(fs::exists(dir / "q.png.partial"));
+}
+
+TEST_CASE("CSV cells: a comma, a quote or a line break stays in its cell, written and read back", "[plot][csv]") {
+  using rocklab::experiments::detail::csvCell;
+  using rocklab::experiments::detail::splitCsvLine;
+  const std::vector<std::string> cells{"[0,0,0.05]", "plain", "", "say \"hi\", then go", "exit 3: a, b", "0.5", ""};
+  std::string line;
+  for (std::size_t k = 0; k < cells.size(); ++k) line += (k ? "," : "") + csvCell(cells[k]);
+  CHECK(line == "\"[0,0,0.05]\",plain,,\"say \"\"hi\"\", then go\",\"exit 3: a, b\",0.5,");
+  CHECK(splitCsvLine(line) == cells);
+  CHECK(splitCsvLine("a,b") == std::vector<std::string>{"a", "b"});
+  // A sweep table with a vary value that holds commas is read back one cell a value.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "rocklab-csv-cells";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream csv(dir / "sweep.csv");
+    csv << "walls.top.corner,clearance_time_s,status\n" << csvCell("[0,0,0.04]") << ",2.5,ok\n";
+  }
+  const auto table = rocklab::experiments::readSweepTable(dir);
+  REQUIRE(table.rows.size() == 1);
+  CHECK(table.rows[0] == std::vector<std::string>{"[0,0,0.04]", "2.5", "ok"});
+  std::filesystem::remove_all(dir);
 }

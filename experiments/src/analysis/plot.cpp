@@ -14,6 +14,7 @@
 
 #include "analysis/plot_internal.h"
 #include "common/atomic_file.h"
+#include "common/csv.h"
 
 namespace rocklab::experiments {
 
@@ -71,22 +72,14 @@ std::string gnuplotProgram() {
 
 namespace {
 
-/// A CSV cell: quoted (quotes doubled) when it holds a comma, a quote or a line break.
-std::string csvCell(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
-
 /// The plotted data, one row a point: series (its legend text, else its number), x, y.
 std::string plotCsv(const PlotSpec& spec) {
-  std::string csv = "series," + csvCell(spec.x_label.empty() ? "x" : spec.x_label) + "," +
-                    csvCell(spec.y_label.empty() ? "y" : spec.y_label) + "\n";
+  std::string csv = "series," + detail::csvCell(spec.x_label.empty() ? "x" : spec.x_label) + "," +
+                    detail::csvCell(spec.y_label.empty() ? "y" : spec.y_label) + "\n";
   char number[64];
   for (std::size_t k = 0; k < spec.series.size(); ++k) {
     const PlotSeries& s = spec.series[k];
-    const std::string name = csvCell(!s.data_name.empty() ? s.data_name
+    const std::string name = detail::csvCell(!s.data_name.empty() ? s.data_name
                                      : s.label.empty()    ? "series " + std::to_string(k + 1)
                                                           : s.label);
     for (std::size_t i = 0; i < s.x.size(); ++i) {

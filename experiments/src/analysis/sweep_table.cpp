@@ -5,20 +5,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/csv.h"
+
 namespace rocklab::experiments {
 
-namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
-}  // namespace
+using detail::splitCsvLine;
 
 std::size_t SweepTable::column(const std::string& name) const {
   for (std::size_t k = 0; k < header.size(); ++k)
@@ -47,12 +38,12 @@ SweepTable readCsvTable(const std::filesystem::path& file, const std::string& mi
   if (!in) throw std::invalid_argument(t.file.string() + ": cannot read" + missing_hint);
   std::string line;
   if (!std::getline(in, line)) throw std::invalid_argument(t.file.string() + ": empty (no header)");
-  t.header = splitCsv(line);
+  t.header = splitCsvLine(line);
   std::size_t status = t.header.size();
   for (std::size_t k = 0; k < t.header.size(); ++k)
     if (t.header[k] == "status") status = k;
   while (std::getline(in, line)) {
-    std::vector<std::string> cells = splitCsv(line);
+    std::vector<std::string> cells = splitCsvLine(line);
     if (status < t.header.size() && (status >= cells.size() || cells[status] != "ok"))
       ++t.not_ok;
     else

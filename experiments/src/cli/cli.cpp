@@ -17,6 +17,7 @@
 #include "analysis/weibull_report.h"
 #include "crusher/crusher_geometry_command.h"
 #include "crusher/products_command.h"
+#include "analysis/profiles_command.h"
 #include "crusher/whiten_command.h"
 #include "report/run_report.h"
 #include "camera/render_run.h"
@@ -60,6 +61,7 @@ Examples:
   rocklab crusher-geometry cone-crusher --set crusher.css=0.012   # chamber quantities + section.png
   rocklab whiten out/crusher --k1-mm 12 --k2-mm 25   # Whiten's model on a crusher run's feed
   rocklab products out/pbm out/bpm --label PBM --label BPM --out out/pbm-bpm   # product curves side by side
+  rocklab profiles runs/inclined runs/vertical --out out/deposition   # chute marker profiles side by side
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -180,6 +182,7 @@ struct CliArgs {
   WhitenCommandOptions whiten;
   // products
   ProductsCommandOptions products;
+  ProfilesCommandOptions profiles;
 };
 
 /// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
@@ -284,6 +287,12 @@ void addCommands(CLI::App& app, CliArgs& a) {
   products->add_option("--label", a.products.labels, "A legend label a run, in their order (default: the folders' names)")
       ->take_all();
   products->add_option("--out", a.out_dir, "Folder for products.csv, products.json and product_curves.png (default: out/products)");
+  auto* profiles = app.add_subcommand(
+      "profiles", "Marker velocity profiles and discharge curves of finished chute runs side by side, with their clearance");
+  profiles->add_option("runs", a.profiles.runs, "Folders of finished chute runs (their results.json)")->required();
+  profiles->add_option("--label", a.profiles.labels, "A legend label a run, in their order (default: the folders' names)")
+      ->take_all();
+  profiles->add_option("--out", a.out_dir, "Folder for profiles.csv, profiles.json and the plots (default: out/profiles)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -558,6 +567,10 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
   if (app.got_subcommand("products")) {
     a.products.out_dir = a.out_dir.empty() ? std::filesystem::path("out/products") : std::filesystem::path(a.out_dir);
     return runProductsCommand(a.products, std::cout, std::cerr);
+  }
+  if (app.got_subcommand("profiles")) {
+    a.profiles.out_dir = a.out_dir.empty() ? std::filesystem::path("out/profiles") : std::filesystem::path(a.out_dir);
+    return runProfilesCommand(a.profiles, std::cout, std::cerr);
   }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);

@@ -6,6 +6,7 @@
 
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
+#include "common/csv.h"
 #include "crusher/psd_curve.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
@@ -94,8 +95,8 @@ int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::
   csv << '\n';
   nlohmann::json table = nlohmann::json::array();
   for (const ProductRun& run : runs) {
-    csv << '"' << run.label << "\",\"" << run.dir.string() << '"';
-    for (const std::string& c : columns) csv << ',' << detail::cell(run.figures[c]);
+    csv << detail::csvCell(run.label) << ',' << detail::csvCell(run.dir.string());
+    for (const std::string& c : columns) csv << ',' << detail::csvCell(detail::cell(run.figures[c]));
     nlohmann::json row = run.figures;
     row["label"] = run.label;
     row["run"] = run.dir.string();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/atomic_file.h"
+#include "common/csv.h"
 #include "common/json_text.h"
 #include "report/html.h"
 
@@ -20,26 +21,24 @@ namespace {
 
 constexpr std::size_t kMaxTableRows = 1000;  // a longer table is cut on the page (the CSV is linked)
 
-std::vector<std::string> splitCsvLine(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream in(line);
-  std::string cell;
-  while (std::getline(in, cell, ',')) cells.push_back(htmlText(cell));
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
+/// A line of a set's table, each cell as HTML text.
+std::vector<std::string> htmlCells(const std::string& line) {
+  std::vector<std::string> cells = detail::splitCsvLine(line);
+  for (std::string& c : cells) c = htmlText(c);
   return cells;
 }
 
 /// The tables a set writes (sweep.csv, study.csv, calibration.csv, ...) as written:
-/// one row a line, cells split at commas (run_set.h writeTable).
+/// one row a line, cells as common/csv.h writes them (run_set.h writeTable).
 std::string csvTable(const fs::path& dir, const fs::path& csv) {
   std::ifstream in(dir / csv);
   std::string line;
   if (!std::getline(in, line)) return "";
-  const std::vector<std::string> header = splitCsvLine(line);
+  const std::vector<std::string> header = htmlCells(line);
   std::vector<std::vector<std::string>> rows;
   std::size_t total = 0;
   while (std::getline(in, line))
-    if (++total <= kMaxTableRows) rows.push_back(splitCsvLine(line));
+    if (++total <= kMaxTableRows) rows.push_back(htmlCells(line));
   std::string s = "<h3>" + link(csv, csv.string()) + "</h3>\n" + htmlTable(header, rows);
   if (total > kMaxTableRows)
     s += "<p>The first " + std::to_string(kMaxTableRows) + " of " + std::to_string(total) + " rows; all in " +

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "common/atomic_file.h"
+#include "common/csv.h"
 #include "common/json_text.h"
 #include "rocklab/sim/output/checkpoint.h"
 
@@ -147,10 +148,10 @@ bool allOk(const std::vector<Variant>& variants) {
 void writeTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
                 const std::filesystem::path& csv_path, std::ostream& log) {
   std::ostringstream csv;
-  for (std::size_t c = 0; c < header.size(); ++c) csv << (c ? "," : "") << header[c];
+  for (std::size_t c = 0; c < header.size(); ++c) csv << (c ? "," : "") << csvCell(header[c]);
   csv << "\n";
   for (const auto& row : rows) {
-    for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << row[c];
+    for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << csvCell(row[c]);
     csv << "\n";
   }
   writeAtomically(csv_path, csv.str());

@@ -1,0 +1,211 @@
+#include "analysis/profiles_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "analysis/plot.h"
+#include "common/atomic_file.h"
+#include "common/csv.h"
+#include "common/json_text.h"
+#include "rocklab/experiments/run.h"
+#include "sets/run_set.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+struct ProfileInputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct MarkerPoint {
+  int column = 0, row = 0;
+  double height_mm = NAN, velocity = NAN;  // start height above the base; mean velocity over the measured travel
+};
+
+struct ChuteRun {
+  std::string label;
+  std::filesystem::path dir;
+  std::vector<MarkerPoint> markers;
+  std::map<int, double> column_distance_m, column_mean;  // by column number
+  std::vector<double> discharge_t, discharge_kg;       // after the gate
+  nlohmann::json figures;                              // the table's row
+};
+
+double numberAt(const nlohmann::json& j, const std::string& key, const std::string& where) {
+  if (!j.is_object() || !j.contains(key)) throw ProfileInputError(where + ": no key '" + key + "'");
+  const nlohmann::json& v = j.at(key);
+  if (v.is_null()) return NAN;  // a marker that never travelled its distance
+  if (!v.is_number()) throw ProfileInputError(where + "." + key + ": " + v.dump() + " is not a number");
+  return v.get<double>();
+}
+
+ChuteRun readRun(const std::filesystem::path& dir) {
+  const nlohmann::json r = detail::readJsonFile(dir / "results.json");
+  if (r.is_discarded()) throw ProfileInputError("cannot read it as JSON (a chute run's folder holds it)");
+  if (!r.is_object() || !r.contains("chute") || !r.contains("markers") || !r.at("markers").is_array())
+    throw ProfileInputError("no keys 'chute' and 'markers' (not a chute run)");
+  ChuteRun run;
+  run.dir = dir;
+  const nlohmann::json& markers = r.at("markers");
+  for (std::size_t k = 0; k < markers.size(); ++k) {
+    const std::string where = "markers." + std::to_string(k);
+    const nlohmann::json& m = markers[k];
+    const nlohmann::json start = m.is_object() ? m.value("start_position_m", nlohmann::json()) : nlohmann::json();
+    if (!start.is_array() || start.size() != 3 || !start[2].is_number())
+      throw ProfileInputError(where + ".start_position_m: not [x, y, z] in m");
+    MarkerPoint p;
+    p.column = static_cast<int>(numberAt(m, "column", where));
+    p.row = static_cast<int>(numberAt(m, "row", where));
+    p.height_mm = 1e3 * start[2].get<double>();
+    p.velocity = numberAt(m, "truth_velocity_mps", where);
+    run.markers.push_back(p);
+  }
+  if (r.contains("profile") && r.at("profile").is_array())
+    for (std::size_t k = 0; k < r.at("profile").size(); ++k) {
+      const std::string where = "profile." + std::to_string(k);
+      const nlohmann::json& c = r.at("profile")[k];
+      const int column = static_cast<int>(numberAt(c, "column", where));
+      run.column_distance_m[column] = numberAt(c, "distance_m", where);
+      run.column_mean[column] = numberAt(c, "mean_truth_velocity_mps", where);
+    }
+  // The discharge curve the run wrote beside results.json (time after the gate, kg).
+  std::ifstream d(dir / "discharge.csv");
+  std::string line;
+  if (d && std::getline(d, line))
+    while (std::getline(d, line)) {
+      std::istringstream cells(line);
+      double t = NAN, m = NAN;
+      char comma = 0;
+      if (!(cells >> t >> comma >> m) || comma != ',')
+        throw ProfileInputError("discharge.csv: the row \"" + line + "\" is not time_s,mass_kg");
+      run.discharge_t.push_back(t);
+      run.discharge_kg.push_back(m);
+    }
+  const nlohmann::json& c = r.at("chute");
+  run.figures = {{"scene", r.value("scene", "")},
+                 {"clearance_time_s", r.value("clearance_time_s", nlohmann::json())},
+                 {"jammed", r.value("jammed", nlohmann::json())},
+                 {"bodies", c.value("bodies", nlohmann::json())},
+                 {"discharged_bodies", c.value("discharged_bodies", nlohmann::json())},
+                 {"discharged_mass_kg", c.value("discharged_mass_kg", nlohmann::json())},
+                 {"deposit_inclination_deg", c.value("deposit_inclination_deg", nlohmann::json())},
+                 {"seed", r.value("seed", nlohmann::json())}};
+  return run;
+}
+
+}  // namespace
+
+int runProfilesCommand(const ProfilesCommandOptions& o, std::ostream& out, std::ostream& err) {
+  if (o.runs.empty()) {
+    err << "error: profiles: no run folder given\n";
+    return kExitBadInput;
+  }
+  if (!o.labels.empty() && o.labels.size() != o.runs.size()) {
+    err << "error: profiles: --label given " << o.labels.size() << " times for " << o.runs.size()
+        << " runs (allowed: one a run, in their order, or none)\n";
+    return kExitBadInput;
+  }
+  std::vector<ChuteRun> runs;
+  for (std::size_t k = 0; k < o.runs.size(); ++k) {
+    try {
+      runs.push_back(readRun(o.runs[k]));
+    } catch (const ProfileInputError& e) {
+      err << "error: " << (o.runs[k] / "results.json").string() << ": " << e.what() << '\n';
+      return kExitBadInput;
+    }
+    std::string label = o.labels.empty() ? o.runs[k].filename().string() : o.labels[k];
+    runs.back().label = label.empty() ? o.runs[k].string() : label;
+  }
+  std::map<int, double> distance_m;  // every column of any run, with its distance from the outlet
+  for (const ChuteRun& run : runs)
+    for (const auto& [column, d] : run.column_distance_m) distance_m.emplace(column, d);
+
+  // The table: one row a marker (the points of the plots), and one a run for the summary.
+  std::ostringstream csv;
+  csv << "label,run,column,column_distance_m,row,start_height_mm,truth_velocity_mps\n";
+  nlohmann::json table = nlohmann::json::array();
+  for (const ChuteRun& run : runs) {
+    for (const MarkerPoint& m : run.markers)
+      csv << detail::csvCell(run.label) << ',' << detail::csvCell(run.dir.string()) << ',' << m.column << ','
+          << detail::cell(distance_m.count(m.column) ? nlohmann::json(distance_m[m.column]) : nlohmann::json())
+          << ',' << m.row << ',' << m.height_mm << ',' << detail::cell(std::isfinite(m.velocity) ? nlohmann::json(m.velocity) : nlohmann::json()) << '\n';
+    nlohmann::json row = run.figures;
+    row["label"] = run.label;
+    row["run"] = run.dir.string();
+    nlohmann::json means = nlohmann::json::array();
+    for (const auto& [column, v] : run.column_mean)
+      means.push_back({{"column", column}, {"distance_m", run.column_distance_m.at(column)},
+                       {"mean_truth_velocity_mps", std::isfinite(v) ? nlohmann::json(v) : nlohmann::json()}});
+    row["columns"] = means;
+    table.push_back(row);
+  }
+
+  // One plot a column: velocity against starting height, a series a run (same colour in every plot).
+  std::vector<std::pair<std::filesystem::path, PlotSpec>> plots;
+  for (const auto& [column, d] : distance_m) {
+    PlotSpec spec;
+    spec.title = "markers of column " + std::to_string(column) + " (" + std::to_string(std::lround(d * 1e3)) +
+                 " mm from the outlet): velocity over their first travel (DEM truth)";
+    spec.x_label = "velocity along the base (m/s)";
+    spec.y_label = "starting height above the base (mm)";
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      std::vector<std::pair<double, double>> points;  // (height, velocity), drawn bottom up
+      for (const MarkerPoint& m : runs[k].markers)
+        if (m.column == column) points.emplace_back(m.height_mm, m.velocity);
+      std::sort(points.begin(), points.end());
+      PlotSeries s{runs[k].label, {}, {}, PlotSeries::Style::LinePoints};
+      for (const auto& [z, v] : points) {
+        s.x.push_back(v);
+        s.y.push_back(z);
+      }
+      s.colour = static_cast<int>(k);
+      spec.series.push_back(s);
+    }
+    plots.emplace_back(o.out_dir / ("profile_column_" + std::to_string(column) + ".png"), spec);
+  }
+  PlotSpec discharge;
+  discharge.title = "discharged mass after the gate opened";
+  discharge.x_label = "time after the gate opened (s)";
+  discharge.y_label = "discharged mass (kg)";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    PlotSeries s{runs[k].label, {0.0}, {0.0}, PlotSeries::Style::Line};
+    s.x.insert(s.x.end(), runs[k].discharge_t.begin(), runs[k].discharge_t.end());
+    s.y.insert(s.y.end(), runs[k].discharge_kg.begin(), runs[k].discharge_kg.end());
+    s.colour = static_cast<int>(k);
+    discharge.series.push_back(s);
+  }
+  plots.emplace_back(o.out_dir / "discharge.png", discharge);
+  try {
+    std::filesystem::create_directories(o.out_dir);
+    detail::writeAtomically(o.out_dir / "profiles.csv", csv.str());
+    detail::writeAtomically(o.out_dir / "profiles.json", detail::jsonText({{"runs", table}}));
+    for (const auto& [png, spec] : plots) writePlot(spec, png);
+  } catch (const std::exception& e) {
+    err << "error: profiles: " << e.what() << '\n';
+    return kExitFailed;
+  }
+  out << std::left << std::setw(28) << "run" << std::right << std::setw(12) << "clearance_s" << std::setw(8) << "jammed";
+  for (const auto& [column, d] : distance_m) out << std::setw(14) << ("col" + std::to_string(column) + "_m/s");
+  out << '\n';
+  for (const ChuteRun& run : runs) {
+    out << std::left << std::setw(28) << run.label << std::right << std::setw(12)
+        << detail::cell(run.figures["clearance_time_s"]) << std::setw(8) << detail::cell(run.figures["jammed"]);
+    for (const auto& [column, d] : distance_m) {
+      const auto it = run.column_mean.find(column);
+      out << std::setw(14) << (it == run.column_mean.end() || !std::isfinite(it->second) ? std::string("-") : detail::cell(it->second));
+    }
+    out << '\n';
+  }
+  out << "wrote " << (o.out_dir / "profiles.csv").string() << ", profiles.json, " << distance_m.size()
+      << " profile_column_N.png and discharge.png\n";
+  return 0;
+}
+
+}  // namespace rocklab::experiments
