@@ -223,7 +223,7 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   sb << "#!/bin/bash\n"
      << "# One Slurm array task per line of runs.txt (each run: one process, one thread).\n"
      << "# Submit: sbatch " << (dir / "slurm.sbatch").string() << "; then: rocklab collect " << dir.string() << "\n"
-     << "#SBATCH --job-name=rocklab-" << fs::path(scene_path).stem().string() << "\n"
+     << "#SBATCH --job-name=rocklab-" << sourceName(scene_path) << "\n"
      << "#SBATCH --array=1-" << planned << "\n"
      << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n"
      << "#SBATCH --mem=" << o.slurm.memory << "\n"
@@ -236,15 +236,17 @@ void writePlanFiles(const fs::path& set_dir, const SweepOptions& o, const std::v
   writeAtomically(dir / "slurm.sbatch", sb.str());
 
   std::ostringstream rd;
-  rd << "# " << what.value("kind", std::string("set")) << " of " << fs::path(scene_path).stem().string() << ": "
-     << planned << " independent runs\n\n";
+  rd << "# " << what.value("kind", std::string("set")) << " of " << sourceName(scene_path) << ": " << planned
+     << " independent runs\n\n";
   if (!left_out.empty()) {
     rd << "Left out, their settings invalid (the message is in `logs/NAME.log`; `plan.json` keeps them):";
     for (const std::string& name : left_out) rd << " `" << name << "`";
     rd << ".\n\n";
   }
   rd
-     << "Each line of `runs.txt` is one run: `rocklab run` with its own `--out` folder under `runs/`, every\n"
+     << "Each line of `runs.txt` is one run: "
+     << (restartsFrom(scene_path) ? "`rocklab restart` from " + scene_path : std::string("`rocklab run`"))
+     << " with its own `--out` folder under `runs/`, every\n"
      << "`--set` it needs (the seed included), one thread, its log and exit code under `logs/`. A line\n"
      << "whose run already completed does nothing (`--skip-complete`), so running the list again, or\n"
      << "after deleting one run folder, redoes only what is missing (an unfinished attempt's files are\n"

@@ -47,6 +47,11 @@ Scene loadSetScene(const std::string& source, const std::vector<std::string>& ov
   }
 }
 
+std::string sourceName(const std::string& source) {
+  const std::filesystem::path p(source);
+  return (restartsFrom(source) ? std::filesystem::absolute(p).parent_path().filename() : p.stem()).string();
+}
+
 std::filesystem::path sourcePath(const std::string& source) {
   return std::filesystem::absolute(restartsFrom(source) ? std::filesystem::path(source) : resolveScene(source));
 }

@@ -30,6 +30,8 @@ bool restartsFrom(const std::string& source);
 /// The scene of a set's source (file, built-in name, or checkpoint: the scene text
 /// it carries) with `overrides`; throws SceneError, a damaged checkpoint included.
 Scene loadSetScene(const std::string& source, const std::vector<std::string>& overrides);
+/// What a set's messages call its source: a scene file's stem, a checkpoint's run folder.
+std::string sourceName(const std::string& source);
 /// The absolute path of a set's source, as its run lines name it.
 std::filesystem::path sourcePath(const std::string& source);
 /// RunOptions of one run of a set into `dir` (the restart from a checkpoint source).

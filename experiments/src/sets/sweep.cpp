@@ -206,8 +206,7 @@ int collectSet(const std::filesystem::path& dir, std::ostream& log) {
   const std::vector<Variant> done = inspectRuns(dir, plan.runs);
   std::size_t complete = 0, failed = 0, missing = 0;
   for (const Variant& v : done) (v.code == kExitOk ? complete : v.code == kMissing ? missing : failed) += 1;
-  const std::filesystem::path source(o.scene);  // a checkpoint is named by its run's folder
-  const std::string name = (restartsFrom(o.scene) ? source.parent_path().filename() : source.stem()).string();
+  const std::string name = sourceName(o.scene);
   log << "collect " << plan.kind << " of " << name << ": " << complete << " complete, " << failed << " failed, "
       << missing << " missing of " << plan.runs.size() << " runs\n";
   if (plan.kind == "sweep") return reportSweep(dir, o, plan.metrics, done, name, log);
