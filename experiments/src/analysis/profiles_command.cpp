@@ -13,6 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/csv.h"
 #include "common/json_text.h"
+#include "common/run_labels.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
 
@@ -103,13 +104,8 @@ ChuteRun readRun(const std::filesystem::path& dir) {
 }  // namespace
 
 int runProfilesCommand(const ProfilesCommandOptions& o, std::ostream& out, std::ostream& err) {
-  if (o.runs.empty()) {
-    err << "error: profiles: no run folder given\n";
-    return kExitBadInput;
-  }
-  if (!o.labels.empty() && o.labels.size() != o.runs.size()) {
-    err << "error: profiles: --label given " << o.labels.size() << " times for " << o.runs.size()
-        << " runs (allowed: one a run, in their order, or none)\n";
+  if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
+    err << "error: profiles: " << problem << "\n";
     return kExitBadInput;
   }
   std::vector<ChuteRun> runs;
@@ -120,8 +116,7 @@ int runProfilesCommand(const ProfilesCommandOptions& o, std::ostream& out, std::
       err << "error: " << (o.runs[k] / "results.json").string() << ": " << e.what() << '\n';
       return kExitBadInput;
     }
-    std::string label = o.labels.empty() ? o.runs[k].filename().string() : o.labels[k];
-    runs.back().label = label.empty() ? o.runs[k].string() : label;
+    runs.back().label = detail::runLabel(o.runs, o.labels, k);
   }
   std::map<int, double> distance_m;  // every column of any run, with its distance from the outlet
   for (const ChuteRun& run : runs)

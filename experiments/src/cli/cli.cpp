@@ -247,6 +247,17 @@ void addSweepOptions(CLI::App* c, CliArgs& a) {
   addRunOptions(c, a);
 }
 
+/// A command that sets finished runs side by side (products, profiles): the run
+/// folders, a legend label a run, the output folder (default out/NAME).
+void addRunComparison(CLI::App& app, const std::string& name, const std::string& what, const std::string& kind,
+                      std::vector<std::filesystem::path>& runs, std::vector<std::string>& labels, std::string& out_dir,
+                      const std::string& outputs) {
+  auto* c = app.add_subcommand(name, what);
+  c->add_option("runs", runs, "Folders of finished " + kind + " runs (their results.json)")->required();
+  c->add_option("--label", labels, "A legend label a run, in their order (default: the folders' names)")->take_all();
+  c->add_option("--out", out_dir, "Folder for " + outputs + " (default: out/" + name + ")");
+}
+
 /// Every subcommand and its options, bound to the fields of `a`.
 void addCommands(CLI::App& app, CliArgs& a) {
   auto* run = app.add_subcommand("run", "Run a scene file (or a built-in scene by name)");
@@ -281,18 +292,14 @@ void addCommands(CLI::App& app, CliArgs& a) {
   whiten->add_option("--exponent", a.whiten.exponent, "Exponent of Eq 3-22 (default 2, as the study prints it)");
   whiten->add_option("--mode", a.whiten.mode, "Breakage split: triple (60/30/10 %) or equal (default: the run's)");
   whiten->add_option("--out", a.out_dir, "Folder for whiten.json and whiten.png (default: the run's folder)");
-  auto* products = app.add_subcommand(
-      "products", "Product curves of finished crusher runs on one sieve chart, with their P50, P80 and breakages");
-  products->add_option("runs", a.products.runs, "Folders of finished crusher runs (their results.json)")->required();
-  products->add_option("--label", a.products.labels, "A legend label a run, in their order (default: the folders' names)")
-      ->take_all();
-  products->add_option("--out", a.out_dir, "Folder for products.csv, products.json and product_curves.png (default: out/products)");
-  auto* profiles = app.add_subcommand(
-      "profiles", "Marker velocity profiles and discharge curves of finished chute runs side by side, with their clearance");
-  profiles->add_option("runs", a.profiles.runs, "Folders of finished chute runs (their results.json)")->required();
-  profiles->add_option("--label", a.profiles.labels, "A legend label a run, in their order (default: the folders' names)")
-      ->take_all();
-  profiles->add_option("--out", a.out_dir, "Folder for profiles.csv, profiles.json and the plots (default: out/profiles)");
+  addRunComparison(app, "products",
+                   "Product curves of finished crusher runs on one sieve chart, with their P50, P80 and breakages",
+                   "crusher", a.products.runs, a.products.labels, a.out_dir,
+                   "products.csv, products.json and product_curves.png");
+  addRunComparison(app, "profiles",
+                   "Marker velocity profiles and discharge curves of finished chute runs side by side, with their "
+                   "clearance",
+                   "chute", a.profiles.runs, a.profiles.labels, a.out_dir, "profiles.csv, profiles.json and the plots");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");

@@ -7,6 +7,7 @@
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "common/csv.h"
+#include "common/run_labels.h"
 #include "crusher/psd_curve.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
@@ -55,13 +56,8 @@ ProductRun readRun(const std::filesystem::path& dir) {
 }  // namespace
 
 int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::ostream& err) {
-  if (o.runs.empty()) {
-    err << "error: products: no run folder given\n";
-    return kExitBadInput;
-  }
-  if (!o.labels.empty() && o.labels.size() != o.runs.size()) {
-    err << "error: products: --label given " << o.labels.size() << " times for " << o.runs.size()
-        << " runs (allowed: one a run, in their order, or none)\n";
+  if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
+    err << "error: products: " << problem << "\n";
     return kExitBadInput;
   }
   std::vector<ProductRun> runs;
@@ -73,9 +69,7 @@ int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::
       err << "error: " << file.string() << ": " << e.what() << '\n';
       return kExitBadInput;
     }
-    std::string label = o.labels.empty() ? o.runs[k].filename().string() : o.labels[k];
-    if (label.empty()) label = o.runs[k].string();
-    runs.back().label = label;
+    runs.back().label = detail::runLabel(o.runs, o.labels, k);
     if (runs.back().sieves != runs.front().sieves) {
       err << "error: " << file.string() << ": crusher.psd: its sieves differ from those of "
           << (o.runs.front() / "results.json").string() << " (allowed: runs on the same sieves)\n";
