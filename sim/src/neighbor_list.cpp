@@ -20,7 +20,6 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
                            std::span<const std::uint64_t> excluded) {
   const std::size_t n = position.size();
   out.row_offset.assign(n + 1, 0);
-  out.col_offset.assign(n + 1, 0);
   out.partner.clear();
   out.col_pair.clear();
   if (n < 2) return;
@@ -160,16 +159,22 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
     ++out.row_offset[(keys_[p] >> 32) + 1];
   }
   for (std::size_t i = 0; i < n; ++i) out.row_offset[i + 1] += out.row_offset[i];
-  if (nthreads == 1) {  // only the threads' hand-over reads the transpose
+  if (nthreads == 1) {  // only the threads' hand-over reads the transpose (built when a team grows)
     out.col_offset.clear();
+    out.col_pair.clear();
     return;
   }
-  for (std::size_t p = 0; p < keys_.size(); ++p) ++out.col_offset[out.partner[p] + 1];
-  for (std::size_t i = 0; i < n; ++i) out.col_offset[i + 1] += out.col_offset[i];
-  out.col_pair.resize(keys_.size());
-  std::vector<std::uint32_t> fill(out.col_offset.begin(), out.col_offset.end() - 1);
-  for (std::size_t p = 0; p < keys_.size(); ++p)
-    out.col_pair[fill[out.partner[p]]++] = static_cast<std::uint32_t>(p);
+  out.buildTranspose();
+}
+
+void PairList::buildTranspose() {
+  const std::size_t n = row_offset.size() - 1;
+  col_offset.assign(n + 1, 0);
+  for (std::size_t p = 0; p < partner.size(); ++p) ++col_offset[partner[p] + 1];
+  for (std::size_t i = 0; i < n; ++i) col_offset[i + 1] += col_offset[i];
+  col_pair.resize(partner.size());
+  std::vector<std::uint32_t> fill(col_offset.begin(), col_offset.end() - 1);
+  for (std::size_t p = 0; p < partner.size(); ++p) col_pair[fill[partner[p]]++] = static_cast<std::uint32_t>(p);
 }
 
 }  // namespace rocklab::sim::detail

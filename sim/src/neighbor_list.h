@@ -25,6 +25,13 @@ struct PairList {
   std::vector<std::uint32_t> col_offset;  // [n+1]
   std::vector<std::uint32_t> col_pair;    // [pairs] pair index, grouped by j
   std::size_t size() const { return partner.size(); }
+  /// True when col_offset/col_pair are this list's transpose (built on two or more
+  /// threads, or by buildTranspose since).
+  bool hasTranspose() const { return !row_offset.empty() && col_offset.size() == row_offset.size(); }
+  /// The transpose (pairs grouped by j, ascending pair index within a group) that
+  /// the threads' hand-over reads: a list built on one thread has none, and a team
+  /// that grows before the next build needs it.
+  void buildTranspose();
 };
 
 class NeighborFinder {

@@ -133,6 +133,40 @@ TEST_CASE("switching between the full team and one thread mid-run changes no bit
   CHECK(mixed.stateHash() == one.stateHash());
 }
 
+TEST_CASE("a team that grows after a neighbour build on one thread changes no bit", "[determinism]") {
+  // The adaptive team may go back to two threads after a rebuild made on one, which
+  // builds no transpose of the pair list (the threads' hand-over reads it): the
+  // pairs across the two ranges must still reach both balls. Until 2026-12-06 they
+  // reached only the first (the full zoned chute lost bits after the team's switches).
+  // Every lattice neighbour touches (spacing 19.9 mm, radius 10 mm): many pairs cross.
+  std::vector<sim::SphereSpec> s;
+  for (const Vec3& x : geometry::latticePoints(geometry::LatticeKind::SimpleCubic, 0.0199, Vec3(0.5, 0.5, 0.5),
+                                               Vec3::Zero(), {30, 20, 10}))
+    s.push_back(test::sphere(x, 0.01, {0.01, 0, 0}));
+  sim::World one(heapModel(), s, 1);
+  sim::World mixed(heapModel(), s, 2);
+  REQUIRE(mixed.fullTeam() == 2);
+  mixed.setTeamPolicy(sim::TeamPolicy::Single);
+  const auto built = mixed.stats().neighbour_rebuilds;
+  for (int k = 0; k < 20000 && mixed.stats().neighbour_rebuilds == built; ++k) {
+    one.step();
+    mixed.step();
+  }
+  REQUIRE(mixed.stats().neighbour_rebuilds > built);  // the list was built on one thread
+  const auto rebuilt = mixed.stats().neighbour_rebuilds;
+  mixed.setTeamPolicy(sim::TeamPolicy::Full);
+  int on_that_list = 0;  // steps the two threads ran on the list built on one
+  for (int k = 0; k < 50; ++k) {
+    one.step();
+    mixed.step();
+    on_that_list += mixed.stats().neighbour_rebuilds == rebuilt;
+  }
+  CHECK(mixed.threads() == 2);
+  CHECK(on_that_list > 0);
+  CHECK(one.touchingContacts().pairs.size() > 1000);
+  CHECK(mixed.stateHash() == one.stateHash());
+}
+
 TEST_CASE("the adaptive team keeps the faster of the full team and one thread", "[determinism]") {
   // The tuner alone, fed step times: it measures a window on its team, probes
   // the other, switches only for a margin, and probes less often while its

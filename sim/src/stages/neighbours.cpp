@@ -105,6 +105,9 @@ void World::Impl::assignRanges() {
     scratch.cross.clear();
     return;
   }
+  // A list built on one thread has no transpose; the team grew since (the adaptive
+  // team, or the policy): without it the hand-over would lose the pairs across ranges.
+  if (!nb.pairs.hasTranspose()) nb.pairs.buildTranspose();
   scratch.cross_index.assign(nb.pairs.size(), ForceScratch::kNotCross);
   scratch.cross_begin.assign(1, 0);
   scratch.cross_ball.clear();
