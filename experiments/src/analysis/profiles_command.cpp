@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -10,6 +9,7 @@
 #include <stdexcept>
 
 #include "analysis/plot.h"
+#include "analysis/sweep_table.h"
 #include "common/atomic_file.h"
 #include "common/csv.h"
 #include "common/json_text.h"
@@ -76,19 +76,24 @@ ChuteRun readRun(const std::filesystem::path& dir) {
       run.column_distance_m[column] = numberAt(c, "distance_m", where);
       run.column_mean[column] = numberAt(c, "mean_truth_velocity_mps", where);
     }
-  // The discharge curve the run wrote beside results.json (time after the gate, kg).
-  std::ifstream d(dir / "discharge.csv");
-  std::string line;
-  if (d && std::getline(d, line))
-    while (std::getline(d, line)) {
-      std::istringstream cells(line);
-      double t = NAN, m = NAN;
-      char comma = 0;
-      if (!(cells >> t >> comma >> m) || comma != ',')
-        throw ProfileInputError("discharge.csv: the row \"" + line + "\" is not time_s,mass_kg");
-      run.discharge_t.push_back(t);
-      run.discharge_kg.push_back(m);
+  // The discharge curve the run wrote beside results.json (time after the gate, kg);
+  // none when the file is missing or empty (the gate never opened).
+  const std::filesystem::path discharge = dir / "discharge.csv";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(discharge, ec) && std::filesystem::file_size(discharge, ec) > 0) {
+    try {
+      const SweepTable t = readCsvTable(discharge);
+      const std::size_t time = t.column("time_after_gate_s"), mass = t.column("discharged_mass_kg");
+      for (const std::vector<std::string>& row : t.rows) {
+        const auto ti = SweepTable::numberIn(row, time), mi = SweepTable::numberIn(row, mass);
+        if (!ti || !mi) throw ProfileInputError("discharge.csv: a row is not time_after_gate_s,discharged_mass_kg");
+        run.discharge_t.push_back(*ti);
+        run.discharge_kg.push_back(*mi);
+      }
+    } catch (const std::invalid_argument& e) {  // unreadable, or a column missing: named by the table reader
+      throw ProfileInputError(e.what());
     }
+  }
   const nlohmann::json& c = r.at("chute");
   run.figures = {{"scene", r.value("scene", "")},
                  {"clearance_time_s", r.value("clearance_time_s", nlohmann::json())},

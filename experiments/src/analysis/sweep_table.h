@@ -20,7 +20,7 @@ struct SweepTable {
   static std::optional<double> numberIn(const std::vector<std::string>& row, std::size_t column);
 };
 
-/// Reads a CSV file with a header row (no quoting: rocklab's own tables); with a
+/// Reads a CSV file with a header row (cells quoted as common/csv.h writes them); with a
 /// `status` column only the rows whose status is "ok" are kept. Throws
 /// std::invalid_argument naming the file (and `missing_hint` when it cannot be read).
 SweepTable readCsvTable(const std::filesystem::path& file, const std::string& missing_hint = "");

@@ -138,7 +138,7 @@ class ChuteExperiment final : public Experiment {
       openGate(world, ctx);
       return true;
     }
-    if (phase_ == Phase::Deposit && deposit_over_) {  // restarted from a run that stopped after its deposit
+    if (stoppedAfterDeposit()) {  // restarted from a run that stopped after its deposit
       endDeposit(world, ctx);
       return true;
     }
@@ -191,7 +191,7 @@ class ChuteExperiment final : public Experiment {
   }
 
   bool restartable() const override { return true; }
-  bool endsBeforeStep() const override { return phase_ == Phase::Deposit && deposit_over_; }
+  bool endsBeforeStep() const override { return stoppedAfterDeposit(); }
 
   nlohmann::json saveState() const override {
     nlohmann::json j;
@@ -303,6 +303,10 @@ class ChuteExperiment final : public Experiment {
     std::sort(tops.begin(), tops.end());
     return tops[static_cast<std::size_t>(0.95 * static_cast<double>(tops.size() - 1))];
   }
+
+  /// The deposit is over (stop_after) and the top plate not yet placed: the run
+  /// ends here, and a restart from here places its plate first.
+  bool stoppedAfterDeposit() const { return phase_ == Phase::Deposit && deposit_over_; }
 
   void endDeposit(std::unique_ptr<sim::World>& world, const ExperimentContext& ctx) {
     const double t = world->time();
@@ -800,7 +804,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"deposit_max_speed_mps", settle_.maxSpeed()},
                 {"settle_scope", e_.top_wall.empty() ? "all" : e_.settle_scope},
                 {"stop_after", e_.stop_after},
-                {"stopped_after_deposit", phase_ == Phase::Deposit && deposit_over_},
+                {"stopped_after_deposit", stoppedAfterDeposit()},
                 {"bed_height_m", bed_height_},
                 {"bodies_removed_by_top_plate", removed_by_top_},
                 {"bodies", bodies_total_},
@@ -889,7 +893,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
       << " s, bed " << bed_height_ * 1e3 << " mm, " << bodies_total_ << " bodies";
   if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";
-  if (phase_ == Phase::Deposit && deposit_over_) {
+  if (stoppedAfterDeposit()) {
     log << "chute: stopped after the deposit (experiment.stop_after = \"deposit\"): restart from "
         << (out_dir / "checkpoint.h5").string()
         << " with each case's top plate (rocklab restart CHECKPOINT --set walls." << (e_.top_wall.empty() ? "NAME" : e_.top_wall)
