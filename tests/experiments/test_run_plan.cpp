@@ -203,6 +203,74 @@ TEST_CASE("study --seeds: each variant runs once per seed and the table gives me
   fs::remove_all(dir);
 }
 
+TEST_CASE("samples: sweeps of the same variants on three samples merge into mean, scatter, range and counts", "[plan]") {
+  // A sample a sweep, as the zoned chute's cases restart from one deposit a sample. Stand-ins
+  // for the runs, chosen so that the statistics are known:
+  //   damping 0.1: restitution 0.70, 0.72, 0.74 (mean 0.72, sample sd 0.02); jammed in the third
+  //   damping 0.2: 0.60, 0.64, and the third sample's run failed (mean 0.62, sd 0.0282843, 2 rows)
+  //   damping 0.3: 0.50, none (the run completed without the figure), 0.56 (mean 0.53, sd 0.0424264)
+  const fs::path dir = fresh("samples");
+  const char* restitution[3][3] = {{"0.70", "0.60", "0.50"}, {"0.72", "0.64", "null"}, {"0.74", "", "0.56"}};
+  const char* damping[3] = {"0.1", "0.2", "0.3"};
+  for (int s = 0; s < 3; ++s) {
+    const fs::path set = dir / ("s" + std::to_string(s + 1));
+    REQUIRE(cli({"sweep", "drop", "--vary", "contact.damping_normal=0.1,0.2,0.3", "--metric", "restitution",
+                 "--metric", "jammed", "--plan", set.string()}) == 0);
+    for (int v = 0; v < 3; ++v) {
+      const fs::path run = set / "runs" / ("contact.damping_normal=" + std::string(damping[v]));
+      fs::create_directories(run);
+      const std::string figure = restitution[s][v];
+      std::ofstream(run / "results.json")
+          << (figure.empty() ? std::string("{\"status\": \"failed\"}")
+                             : "{\"status\": \"completed\", \"restitution\": " + figure + ", \"jammed\": " +
+                                   (s == 2 && v == 0 ? "true" : "false") + "}");
+    }
+    CHECK(cli({"collect", set.string()}) == (s == 2 ? 4 : 0));  // the failed run: exit 4, its row not ok
+  }
+  const fs::path merged = dir / "merged";
+  REQUIRE(cli({"samples", (dir / "s1").string(), (dir / "s2").string(), (dir / "s3").string(), "--label", "first",
+               "--label", "second", "--label", "third", "--out", merged.string()}) == 0);
+  const auto table = lines(merged / "samples.csv");
+  REQUIRE(table.size() == 4);
+  CHECK(table[0] == "contact.damping_normal,samples,restitution.mean,restitution.sd,restitution.min,restitution.max,"
+                    "restitution.n,jammed.true,jammed.n");
+  CHECK(table[1] == "0.1,3,0.72,0.02,0.7,0.74,3,1,3");
+  CHECK(table[2] == "0.2,2,0.62,0.0282843,0.6,0.64,2,0,2");
+  CHECK(table[3] == "0.3,3,0.53,0.0424264,0.5,0.56,2,0,3");
+  const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(merged / "samples.json"));
+  CHECK(j["samples"][2]["label"] == "third");
+  CHECK(j["samples"][2]["runs_not_ok"] == 1);
+  CHECK(j["variants"][1]["figures"]["restitution"]["per_sample"] == nlohmann::json::parse("[0.6, 0.64, null]"));
+  CHECK(j["variants"][2]["figures"]["restitution"]["per_sample"] == nlohmann::json::parse("[0.5, null, 0.56]"));
+  CHECK(j["variants"][0]["figures"]["jammed"]["per_sample"] == nlohmann::json::parse("[false, false, true]"));
+  CHECK(fs::file_size(merged / "samples.png") > 1000);
+
+  // Bad input: nothing written, exit 2, the message naming the file and what is allowed.
+  const fs::path nothing = dir / "nothing";
+  REQUIRE(cli({"sweep", "drop", "--vary", "timestep.safety_factor=0.4", "--metric", "restitution", "--plan",
+               (dir / "other").string()}) == 0);
+  std::string log;
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"samples", (dir / "s1").string(), (dir / "other").string(), "--out", nothing.string()}, log) == 2);
+  CHECK(log.find((dir / "other" / "sweep.csv").string()) != std::string::npos);  // planned, never collected
+  CHECK(log.find("rocklab collect") != std::string::npos);
+  fs::create_directories(dir / "other" / "runs" / "timestep.safety_factor=0.4");
+  std::ofstream(dir / "other" / "runs" / "timestep.safety_factor=0.4" / "results.json")
+      << "{\"status\": \"completed\", \"restitution\": 0.7}";
+  REQUIRE(cli({"collect", (dir / "other").string()}) == 0);
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"samples", (dir / "s1").string(), (dir / "other").string(), "--out", nothing.string()}, log) == 2);
+  CHECK(log.find("varies timestep.safety_factor") != std::string::npos);
+  CHECK(log.find("allowed: sweeps of the same keys") != std::string::npos);
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"samples", (dir / "s1").string(), "--figure", "jammed", "--out", nothing.string()}, log) == 2);
+  CHECK(log.find("allowed: a figure column with numbers: restitution") != std::string::npos);
+  CHECK(cli({"samples", (dir / "s1").string(), "--label", "a", "--label", "b", "--out", nothing.string()}) == 2);
+  CHECK(cli({"samples", dir.string(), "--out", nothing.string()}) == 2);  // no plan.json
+  CHECK_FALSE(fs::exists(nothing));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and says so", "[plan][cli]") {
   // Slurm's SIGTERM or a `kill` reaches the sweep's process only (its runs are process
   // groups of their own); it passes the stop on, so no run goes on orphaned.

@@ -13,7 +13,7 @@
 #include "common/atomic_file.h"
 #include "common/csv.h"
 #include "common/json_text.h"
-#include "common/run_labels.h"
+#include "common/run_comparison.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
 
@@ -108,7 +108,7 @@ ChuteRun readRun(const std::filesystem::path& dir) {
 
 }  // namespace
 
-int runProfilesCommand(const ProfilesCommandOptions& o, std::ostream& out, std::ostream& err) {
+int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::ostream& err) {
   if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
     err << "error: profiles: " << problem << "\n";
     return kExitBadInput;

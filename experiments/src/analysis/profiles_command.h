@@ -10,17 +10,13 @@
 #include <string>
 #include <vector>
 
-namespace rocklab::experiments {
+#include "common/run_comparison.h"
 
-struct ProfilesCommandOptions {
-  std::vector<std::filesystem::path> runs;  // folders of finished chute runs
-  std::vector<std::string> labels;          // one a run, or none (the folders' names)
-  std::filesystem::path out_dir;            // profiles.csv, profiles.json, profile_column_N.png, discharge.png
-};
+namespace rocklab::experiments {
 
 /// Exit code: 0, or 2 (a folder without a chute run's results.json, a marker without
 /// its figures, labels not one a run; nothing written) with the message on err naming
 /// the file and key.
-int runProfilesCommand(const ProfilesCommandOptions& options, std::ostream& out, std::ostream& err);
+int runProfilesCommand(const RunComparisonOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace rocklab::experiments

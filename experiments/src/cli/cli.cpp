@@ -18,6 +18,7 @@
 #include "crusher/crusher_geometry_command.h"
 #include "crusher/products_command.h"
 #include "analysis/profiles_command.h"
+#include "analysis/samples_command.h"
 #include "crusher/whiten_command.h"
 #include "report/run_report.h"
 #include "camera/render_run.h"
@@ -62,6 +63,7 @@ Examples:
   rocklab whiten out/crusher --k1-mm 12 --k2-mm 25   # Whiten's model on a crusher run's feed
   rocklab products out/pbm out/bpm --label PBM --label BPM --out out/pbm-bpm   # product curves side by side
   rocklab profiles runs/inclined runs/vertical --out out/deposition   # chute marker profiles side by side
+  rocklab samples runs/lab-s1 runs/lab-s2 runs/lab-s3 --out runs/lab   # a sweep's mean and scatter over samples
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -180,9 +182,8 @@ struct CliArgs {
   int count = 30, trials = 3, trial_orientations = 1;
   // whiten
   WhitenCommandOptions whiten;
-  // products
-  ProductsCommandOptions products;
-  ProfilesCommandOptions profiles;
+  // products, profiles, samples (one of them a command line)
+  RunComparisonOptions comparison;
 };
 
 /// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
@@ -247,15 +248,16 @@ void addSweepOptions(CLI::App* c, CliArgs& a) {
   addRunOptions(c, a);
 }
 
-/// A command that sets finished runs side by side (products, profiles): the run
-/// folders, a legend label a run, the output folder (default out/NAME).
-void addRunComparison(CLI::App& app, const std::string& name, const std::string& what, const std::string& kind,
-                      std::vector<std::filesystem::path>& runs, std::vector<std::string>& labels, std::string& out_dir,
-                      const std::string& outputs) {
+/// A command that sets finished runs or sets side by side (products, profiles,
+/// samples): the folders, a legend label a folder, the output folder (default out/NAME).
+CLI::App* addRunComparison(CLI::App& app, CliArgs& a, const std::string& name, const std::string& what,
+                           const std::string& folders, const std::string& outputs) {
   auto* c = app.add_subcommand(name, what);
-  c->add_option("runs", runs, "Folders of finished " + kind + " runs (their results.json)")->required();
-  c->add_option("--label", labels, "A legend label a run, in their order (default: the folders' names)")->take_all();
-  c->add_option("--out", out_dir, "Folder for " + outputs + " (default: out/" + name + ")");
+  c->add_option("folders", a.comparison.runs, folders)->required();
+  c->add_option("--label", a.comparison.labels, "A legend label a folder, in their order (default: the folders' names)")
+      ->take_all();
+  c->add_option("--out", a.out_dir, "Folder for " + outputs + " (default: out/" + name + ")");
+  return c;
 }
 
 /// Every subcommand and its options, bound to the fields of `a`.
@@ -292,14 +294,22 @@ void addCommands(CLI::App& app, CliArgs& a) {
   whiten->add_option("--exponent", a.whiten.exponent, "Exponent of Eq 3-22 (default 2, as the study prints it)");
   whiten->add_option("--mode", a.whiten.mode, "Breakage split: triple (60/30/10 %) or equal (default: the run's)");
   whiten->add_option("--out", a.out_dir, "Folder for whiten.json and whiten.png (default: the run's folder)");
-  addRunComparison(app, "products",
+  addRunComparison(app, a, "products",
                    "Product curves of finished crusher runs on one sieve chart, with their P50, P80 and breakages",
-                   "crusher", a.products.runs, a.products.labels, a.out_dir,
+                   "Folders of finished crusher runs (their results.json)",
                    "products.csv, products.json and product_curves.png");
-  addRunComparison(app, "profiles",
+  addRunComparison(app, a, "profiles",
                    "Marker velocity profiles and discharge curves of finished chute runs side by side, with their "
                    "clearance",
-                   "chute", a.profiles.runs, a.profiles.labels, a.out_dir, "profiles.csv, profiles.json and the plots");
+                   "Folders of finished chute runs (their results.json)", "profiles.csv, profiles.json and the plots");
+  auto* samples = addRunComparison(
+      app, a, "samples",
+      "Sweeps of the same variants on different samples (a seed or a deposit each) merged: every figure's mean, "
+      "sample standard deviation and range a variant",
+      "Folders of finished sweeps, one a sample (their plan.json and sweep.csv)",
+      "samples.csv, samples.json and samples.png");
+  samples->add_option("--figure", a.figure,
+                      "The sweep.csv column to plot and print (default: the first with numbers)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -571,13 +581,12 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     a.whiten.out_dir = a.out_dir;
     return runWhitenCommand(a.whiten, std::cout, std::cerr);
   }
-  if (app.got_subcommand("products")) {
-    a.products.out_dir = a.out_dir.empty() ? std::filesystem::path("out/products") : std::filesystem::path(a.out_dir);
-    return runProductsCommand(a.products, std::cout, std::cerr);
-  }
-  if (app.got_subcommand("profiles")) {
-    a.profiles.out_dir = a.out_dir.empty() ? std::filesystem::path("out/profiles") : std::filesystem::path(a.out_dir);
-    return runProfilesCommand(a.profiles, std::cout, std::cerr);
+  for (const std::string command : {"products", "profiles", "samples"}) {
+    if (!app.got_subcommand(command)) continue;
+    a.comparison.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / command : std::filesystem::path(a.out_dir);
+    if (command == "products") return runProductsCommand(a.comparison, std::cout, std::cerr);
+    if (command == "profiles") return runProfilesCommand(a.comparison, std::cout, std::cerr);
+    return runSamplesCommand(a.comparison, a.figure, std::cout, std::cerr);
   }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);

@@ -7,7 +7,7 @@
 #include "analysis/plot.h"
 #include "common/atomic_file.h"
 #include "common/csv.h"
-#include "common/run_labels.h"
+#include "common/run_comparison.h"
 #include "crusher/psd_curve.h"
 #include "rocklab/experiments/run.h"
 #include "sets/run_set.h"
@@ -55,7 +55,7 @@ ProductRun readRun(const std::filesystem::path& dir) {
 
 }  // namespace
 
-int runProductsCommand(const ProductsCommandOptions& o, std::ostream& out, std::ostream& err) {
+int runProductsCommand(const RunComparisonOptions& o, std::ostream& out, std::ostream& err) {
   if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
     err << "error: products: " << problem << "\n";
     return kExitBadInput;

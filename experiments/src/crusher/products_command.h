@@ -8,17 +8,13 @@
 #include <string>
 #include <vector>
 
-namespace rocklab::experiments {
+#include "common/run_comparison.h"
 
-struct ProductsCommandOptions {
-  std::vector<std::filesystem::path> runs;  // folders of finished crusher runs
-  std::vector<std::string> labels;          // one a run, or none (the folders' names)
-  std::filesystem::path out_dir;            // products.csv, products.json, product_curves.png
-};
+namespace rocklab::experiments {
 
 /// Exit code: 0, or 2 (a folder without a crusher run's results.json, a damaged curve,
 /// runs on different sieves, labels not one a run; nothing written) with the message
 /// on err naming the file and key.
-int runProductsCommand(const ProductsCommandOptions& options, std::ostream& out, std::ostream& err);
+int runProductsCommand(const RunComparisonOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace rocklab::experiments

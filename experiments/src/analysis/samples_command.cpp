@@ -1,0 +1,392 @@
+#include "analysis/samples_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "analysis/plot.h"
+#include "analysis/sweep_table.h"
+#include "common/atomic_file.h"
+#include "common/csv.h"
+#include "common/json_text.h"
+#include "rocklab/experiments/run.h"
+#include "sets/plan_file.h"
+#include "sets/run_set.h"
+
+namespace rocklab::experiments {
+
+namespace {
+
+using json = nlohmann::json;
+
+struct SamplesInputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// One sample: a finished sweep's varied keys and table (its runs that ended normally).
+struct SampleSet {
+  std::string label;
+  std::filesystem::path dir;
+  std::vector<std::string> keys;  // the plan's order
+  SweepTable table;
+};
+
+SampleSet readSet(const std::filesystem::path& dir) {
+  SampleSet set;
+  set.dir = dir;
+  detail::PlanFile plan;
+  try {
+    plan = detail::readPlanFile(dir);
+  } catch (const detail::PlanFileError& e) {
+    throw SamplesInputError(e.what());
+  }
+  if (plan.kind != "sweep")
+    throw SamplesInputError((dir / "plan.json").string() + ": kind \"" + plan.kind +
+                            "\" (allowed: \"sweep\"; a study merges its seeds itself, `rocklab study --seeds`)");
+  for (const auto& [key, values] : plan.options.vary) set.keys.push_back(key);
+  try {
+    set.table = readCsvTable(dir / "sweep.csv", " (a finished sweep's folder holds it; `rocklab collect " +
+                                                    dir.string() + "` writes it from the runs)");
+    for (const std::string& key : set.keys) set.table.column(key);
+  } catch (const std::invalid_argument& e) {
+    throw SamplesInputError(e.what());
+  }
+  return set;
+}
+
+/// The columns of a table that are figures: neither a varied key nor the status.
+std::vector<std::string> figureColumns(const SampleSet& s) {
+  std::vector<std::string> figures;
+  for (const std::string& h : s.table.header)
+    if (h != "status" && std::find(s.keys.begin(), s.keys.end(), h) == s.keys.end()) figures.push_back(h);
+  return figures;
+}
+
+std::string joined(std::vector<std::string> names) {
+  std::sort(names.begin(), names.end());
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "none" : s;
+}
+
+/// The sets must vary the same keys and tabulate the same figures (in any order).
+void checkSameShape(const std::vector<SampleSet>& sets) {
+  const SampleSet& first = sets.front();
+  const std::set<std::string> keys(first.keys.begin(), first.keys.end());
+  const std::vector<std::string> first_figures = figureColumns(first);
+  const std::set<std::string> figures(first_figures.begin(), first_figures.end());
+  for (const SampleSet& s : sets) {
+    if (std::set<std::string>(s.keys.begin(), s.keys.end()) != keys)
+      throw SamplesInputError((s.dir / "plan.json").string() + ": varies " + joined(s.keys) + ", " +
+                              (first.dir / "plan.json").string() + " varies " + joined(first.keys) +
+                              " (allowed: sweeps of the same keys, one a sample)");
+    const std::vector<std::string> own = figureColumns(s);
+    if (std::set<std::string>(own.begin(), own.end()) != figures)
+      throw SamplesInputError(s.table.file.string() + ": figures " + joined(own) + ", " + first.table.file.string() +
+                              " has " + joined(first_figures) + " (allowed: sweeps with the same --metric figures)");
+  }
+}
+
+enum class FigureKind { Number, Flag, Text };
+
+bool isFlag(const std::string& cell) { return cell == "true" || cell == "false"; }
+
+/// What a figure's cells hold over every variant and sample (empty cells aside).
+FigureKind kindOf(const std::vector<std::vector<std::optional<std::string>>>& cells) {
+  bool numbers = true, flags = true;
+  for (const auto& variant : cells)
+    for (const auto& c : variant) {
+      if (!c || c->empty()) continue;
+      numbers = numbers && SweepTable::numberIn({*c}, 0).has_value();
+      flags = flags && isFlag(*c);
+    }
+  if (numbers) return FigureKind::Number;  // also when every cell is empty
+  return flags ? FigureKind::Flag : FigureKind::Text;
+}
+
+struct Statistics {
+  std::size_t n = 0, true_count = 0;
+  double mean = NAN, sd = NAN, min = NAN, max = NAN;  // sd: sample standard deviation (n - 1)
+  std::vector<std::string> texts;                     // distinct, for text figures
+};
+
+Statistics statisticsOf(FigureKind kind, const std::vector<std::optional<std::string>>& cells) {
+  Statistics st;
+  std::vector<double> v;
+  for (const auto& c : cells) {
+    if (!c || c->empty()) continue;
+    ++st.n;
+    if (kind == FigureKind::Number) v.push_back(*SweepTable::numberIn({*c}, 0));
+    if (kind == FigureKind::Flag) st.true_count += *c == "true";
+    if (kind == FigureKind::Text && std::find(st.texts.begin(), st.texts.end(), *c) == st.texts.end())
+      st.texts.push_back(*c);
+  }
+  if (v.empty()) return st;
+  st.mean = 0.0;
+  for (double x : v) st.mean += x / static_cast<double>(v.size());
+  st.min = *std::min_element(v.begin(), v.end());
+  st.max = *std::max_element(v.begin(), v.end());
+  if (v.size() > 1) {
+    double ss = 0.0;
+    for (double x : v) ss += (x - st.mean) * (x - st.mean);
+    st.sd = std::sqrt(ss / static_cast<double>(v.size() - 1));
+  }
+  return st;
+}
+
+json numberJson(double v) { return std::isfinite(v) ? json(v) : json(); }
+
+/// A cell as samples.json gives it: a number, true/false, text, or null (empty or no run).
+json cellJson(FigureKind kind, const std::optional<std::string>& c) {
+  if (!c || c->empty()) return json();
+  if (kind == FigureKind::Number) return *SweepTable::numberIn({*c}, 0);
+  if (kind == FigureKind::Flag) return *c == "true";
+  return *c;
+}
+
+/// The merged table: variants in the order the first sample's table lists them
+/// (then any only later samples ran), each figure's cells a sample.
+struct Merged {
+  std::vector<std::string> keys, figures;
+  std::vector<std::vector<std::string>> variants;                         // values in `keys` order
+  std::vector<std::size_t> rows;                                          // samples with a row
+  std::vector<std::vector<std::vector<std::optional<std::string>>>> cells;  // [figure][variant][sample]
+  std::vector<FigureKind> kinds;                                          // a figure
+};
+
+Merged merge(const std::vector<SampleSet>& sets) {
+  Merged m;
+  m.keys = sets.front().keys;
+  m.figures = figureColumns(sets.front());
+  std::map<std::vector<std::string>, std::size_t> index;
+  std::vector<std::vector<bool>> seen;  // [variant][sample]
+  m.cells.assign(m.figures.size(), {});
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const SweepTable& t = sets[s].table;
+    std::vector<std::size_t> key_columns, figure_columns;
+    for (const std::string& k : m.keys) key_columns.push_back(t.column(k));
+    for (const std::string& f : m.figures) figure_columns.push_back(t.column(f));
+    for (const std::vector<std::string>& row : t.rows) {
+      std::vector<std::string> values;
+      for (std::size_t c : key_columns) values.push_back(c < row.size() ? row[c] : "");
+      auto [it, added] = index.emplace(values, m.variants.size());
+      if (added) {
+        m.variants.push_back(values);
+        m.rows.push_back(0);
+        seen.emplace_back(sets.size(), false);
+        for (auto& figure : m.cells) figure.emplace_back(sets.size());
+      }
+      const std::size_t v = it->second;
+      if (seen[v][s]) continue;  // a variant twice in one table: its first row
+      seen[v][s] = true;
+      ++m.rows[v];
+      for (std::size_t f = 0; f < figure_columns.size(); ++f)
+        m.cells[f][v][s] = figure_columns[f] < row.size() ? row[figure_columns[f]] : std::string();
+    }
+  }
+  for (const auto& figure : m.cells) m.kinds.push_back(kindOf(figure));
+  return m;
+}
+
+std::string formatted(double v) { return detail::cell(numberJson(v)); }
+
+/// samples.png: the figure against the first varied key whose values are all numbers
+/// (else the variant's row), a group a combination of the other keys; each sample a
+/// point, the mean a line where every sample has the figure.
+PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
+  std::optional<std::size_t> x_key;
+  for (std::size_t k = 0; k < m.keys.size() && !x_key; ++k) {
+    bool all = true;
+    for (const auto& values : m.variants) all = all && SweepTable::numberIn(values, k).has_value();
+    if (all) x_key = k;
+  }
+  PlotSpec spec;
+  spec.title = m.figures[figure] + " over " + std::to_string(samples) +
+               " samples: each sample a point, the mean a line where every sample has it";
+  spec.x_label = x_key ? m.keys[*x_key] : "variant (row of samples.csv)";
+  spec.y_label = m.figures[figure];
+  std::map<std::string, std::vector<std::size_t>> groups;  // by the other keys' values
+  std::vector<std::string> group_order;
+  for (std::size_t v = 0; v < m.variants.size(); ++v) {
+    std::string group;
+    for (std::size_t k = 0; k < m.keys.size(); ++k)
+      if (!x_key || k != *x_key) group += (group.empty() ? "" : ", ") + m.keys[k] + " = " + m.variants[v][k];
+    if (!x_key) group.clear();  // no numeric key: one series, the variants in a row
+    if (groups[group].empty()) group_order.push_back(group);
+    groups[group].push_back(v);
+  }
+  for (std::size_t g = 0; g < group_order.size(); ++g) {
+    const std::string& name = group_order[g];
+    std::vector<std::size_t> members = groups[name];
+    const auto xOf = [&](std::size_t v) {
+      return x_key ? *SweepTable::numberIn(m.variants[v], *x_key) : static_cast<double>(v + 1);
+    };
+    std::sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) { return xOf(a) < xOf(b); });
+    PlotSeries points{name.empty() ? "each sample" : name + ": each sample", {}, {}, PlotSeries::Style::Points};
+    PlotSeries mean{name.empty() ? "mean" : name + ": mean", {}, {}, PlotSeries::Style::LinePoints};
+    for (std::size_t v : members) {
+      const auto& cells = m.cells[figure][v];
+      std::size_t have = 0;
+      for (const auto& c : cells)
+        if (const auto y = c ? SweepTable::numberIn({*c}, 0) : std::nullopt) {
+          points.x.push_back(xOf(v));
+          points.y.push_back(*y);
+          ++have;
+        }
+      const Statistics st = statisticsOf(FigureKind::Number, cells);
+      mean.x.push_back(xOf(v));
+      mean.y.push_back(have == samples ? st.mean : NAN);  // a line break where a sample has none
+    }
+    points.colour = mean.colour = static_cast<int>(g);
+    spec.series.push_back(points);
+    spec.series.push_back(mean);
+  }
+  return spec;
+}
+
+}  // namespace
+
+int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_name, std::ostream& out,
+                      std::ostream& err) {
+  if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
+    err << "error: samples: " << problem << "\n";
+    return kExitBadInput;
+  }
+  std::vector<SampleSet> sets;
+  Merged m;
+  std::optional<std::size_t> figure;
+  try {
+    for (std::size_t k = 0; k < o.runs.size(); ++k) {
+      sets.push_back(readSet(o.runs[k]));
+      sets.back().label = detail::runLabel(o.runs, o.labels, k);
+    }
+    checkSameShape(sets);
+    m = merge(sets);
+    for (std::size_t f = 0; f < m.figures.size(); ++f) {
+      const bool any = std::any_of(m.cells[f].begin(), m.cells[f].end(), [](const auto& variant) {
+        return std::any_of(variant.begin(), variant.end(), [](const auto& c) { return c && !c->empty(); });
+      });
+      if (figure_name.empty() ? (m.kinds[f] == FigureKind::Number && any && !figure) : m.figures[f] == figure_name)
+        figure = f;
+    }
+    if (!figure_name.empty() && (!figure || m.kinds[*figure] != FigureKind::Number))
+      throw SamplesInputError("--figure " + figure_name + ": " +
+                              (figure ? "not numbers in " : "not a column of ") + sets.front().table.file.string() +
+                              " (allowed: a figure column with numbers: " + [&] {
+                                std::vector<std::string> allowed;
+                                for (std::size_t f = 0; f < m.figures.size(); ++f)
+                                  if (m.kinds[f] == FigureKind::Number) allowed.push_back(m.figures[f]);
+                                return joined(allowed);
+                              }() + ")");
+  } catch (const SamplesInputError& e) {
+    err << "error: samples: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+
+  // samples.csv and samples.json: a row a variant.
+  std::ostringstream csv;
+  for (const std::string& k : m.keys) csv << detail::csvCell(k) << ',';
+  csv << "samples";
+  for (std::size_t f = 0; f < m.figures.size(); ++f) {
+    const std::string& name = m.figures[f];
+    switch (m.kinds[f]) {
+      case FigureKind::Number:
+        for (const char* s : {".mean", ".sd", ".min", ".max", ".n"}) csv << ',' << detail::csvCell(name + s);
+        break;
+      case FigureKind::Flag: csv << ',' << detail::csvCell(name + ".true") << ',' << detail::csvCell(name + ".n"); break;
+      case FigureKind::Text: csv << ',' << detail::csvCell(name + ".values"); break;
+    }
+  }
+  csv << '\n';
+  json variants = json::array();
+  for (std::size_t v = 0; v < m.variants.size(); ++v) {
+    json row = {{"values", json::object()}, {"samples", m.rows[v]}, {"figures", json::object()}};
+    for (std::size_t k = 0; k < m.keys.size(); ++k) {
+      csv << detail::csvCell(m.variants[v][k]) << ',';
+      row["values"][m.keys[k]] = m.variants[v][k];
+    }
+    csv << m.rows[v];
+    for (std::size_t f = 0; f < m.figures.size(); ++f) {
+      const Statistics st = statisticsOf(m.kinds[f], m.cells[f][v]);
+      json entry = {{"n", st.n}, {"per_sample", json::array()}};
+      for (const auto& c : m.cells[f][v]) entry["per_sample"].push_back(cellJson(m.kinds[f], c));
+      switch (m.kinds[f]) {
+        case FigureKind::Number:
+          csv << ',' << formatted(st.mean) << ',' << formatted(st.sd) << ',' << formatted(st.min) << ','
+              << formatted(st.max) << ',' << st.n;
+          entry.update({{"mean", numberJson(st.mean)}, {"sd", numberJson(st.sd)}, {"min", numberJson(st.min)},
+                        {"max", numberJson(st.max)}});
+          break;
+        case FigureKind::Flag:
+          csv << ',' << st.true_count << ',' << st.n;
+          entry["true"] = st.true_count;
+          break;
+        case FigureKind::Text: {
+          std::string all;
+          for (const std::string& t : st.texts) all += (all.empty() ? "" : "; ") + t;
+          csv << ',' << detail::csvCell(all);
+          entry["values"] = st.texts;
+          break;
+        }
+      }
+      row["figures"][m.figures[f]] = entry;
+    }
+    csv << '\n';
+    variants.push_back(row);
+  }
+  json samples = json::array();
+  for (const SampleSet& s : sets)
+    samples.push_back({{"label", s.label}, {"sweep", s.dir.string()}, {"runs_not_ok", s.table.not_ok}});
+  const json summary = {{"samples", samples},
+                        {"keys", m.keys},
+                        {"statistics", "mean, sample standard deviation (n - 1), min, max over the samples that have "
+                                       "the figure (n); true/false figures: how many of n are true"},
+                        {"variants", variants}};
+  try {
+    std::filesystem::create_directories(o.out_dir);
+    detail::writeAtomically(o.out_dir / "samples.csv", csv.str());
+    detail::writeAtomically(o.out_dir / "samples.json", detail::jsonText(summary));
+    if (figure) writePlot(samplesPlot(m, *figure, sets.size()), o.out_dir / "samples.png");
+  } catch (const std::exception& e) {
+    err << "error: samples: " << e.what() << '\n';
+    return kExitFailed;
+  }
+
+  // The console table: the plotted figure as mean ± sd [min, max] (n), the flags as k/n.
+  for (const std::string& k : m.keys) out << std::left << std::setw(24) << k << ' ';
+  out << std::right << std::setw(8) << "samples";
+  if (figure) out << "  " << m.figures[*figure] << ": mean ± sd [min, max] (n)";
+  for (std::size_t f = 0; f < m.figures.size(); ++f)
+    if (m.kinds[f] == FigureKind::Flag) out << "  " << m.figures[f] << " (true/n)";
+  out << '\n';
+  for (std::size_t v = 0; v < m.variants.size(); ++v) {
+    for (const std::string& value : m.variants[v]) out << std::left << std::setw(24) << value << ' ';
+    out << std::right << std::setw(8) << m.rows[v];
+    if (figure) {
+      const Statistics st = statisticsOf(FigureKind::Number, m.cells[*figure][v]);
+      if (st.n == 0) out << "  - (0)";
+      else
+        out << "  " << formatted(st.mean) << " ± " << (st.n > 1 ? formatted(st.sd) : "-") << " ["
+            << formatted(st.min) << ", " << formatted(st.max) << "] (" << st.n << ")";
+    }
+    for (std::size_t f = 0; f < m.figures.size(); ++f)
+      if (m.kinds[f] == FigureKind::Flag) {
+        const Statistics st = statisticsOf(FigureKind::Flag, m.cells[f][v]);
+        out << "  " << st.true_count << '/' << st.n;
+      }
+    out << '\n';
+  }
+  for (const SampleSet& s : sets)
+    if (s.table.not_ok) out << "note: " << s.label << ": " << s.table.not_ok << " run(s) not ok, left out\n";
+  out << "wrote " << (o.out_dir / "samples.csv").string() << ", samples.json"
+      << (figure ? ", samples.png" : " (no figure with numbers: no plot)") << '\n';
+  return 0;
+}
+
+}  // namespace rocklab::experiments
