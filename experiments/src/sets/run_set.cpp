@@ -53,7 +53,9 @@ std::string sourceName(const std::string& source) {
 }
 
 std::filesystem::path sourcePath(const std::string& source) {
-  return std::filesystem::absolute(restartsFrom(source) ? std::filesystem::path(source) : resolveScene(source));
+  // Normal form: run lines and plan.json name /runs/deposit, not /work/../runs/deposit.
+  return std::filesystem::absolute(restartsFrom(source) ? std::filesystem::path(source) : resolveScene(source))
+      .lexically_normal();
 }
 
 RunOptions setRunOptions(const SweepOptions& o, const std::filesystem::path& dir) {
