@@ -29,9 +29,12 @@ std::string clockText(double s) {
 class Progress {
  public:
   /// `first_step`: the step count the run starts from (a restart's is its checkpoint's),
-  /// so that steps/s and the ETA count only what this process stepped.
-  Progress(bool enabled, std::uint64_t total_steps, std::uint64_t first_step, double dt)
+  /// so that steps/s and the ETA count only what this process stepped. `may_end_early`:
+  /// an experiment that can end on its own criterion (a chute's clearance, a deposit that
+  /// settles) before scene.end_time, whose ETA is then an upper bound ("ETA <=").
+  Progress(bool enabled, std::uint64_t total_steps, std::uint64_t first_step, double dt, bool may_end_early)
       : enabled_(enabled),
+        may_end_early_(may_end_early),
         tty_(isatty(STDERR_FILENO)),
         total_(total_steps),
         first_(first_step),
@@ -52,7 +55,7 @@ class Progress {
     std::ostringstream s;
     s << std::fixed << std::setprecision(4) << "t = " << done * dt_ << " / " << total_ * dt_
       << " s  " << std::setprecision(1) << 100.0 * done / total_ << "%  " << std::setprecision(0)
-      << rate << " steps/s  ETA " << clockText(eta) << "  " << extra();
+      << rate << " steps/s  ETA " << (may_end_early_ ? "<= " : "") << clockText(eta) << "  " << extra();
     std::cerr << (tty_ ? "\r" : "") << s.str() << (tty_ ? "\033[K" : "\n") << std::flush;
     printed_ = true;
   }
@@ -61,7 +64,7 @@ class Progress {
   }
 
  private:
-  bool enabled_, tty_;
+  bool enabled_, may_end_early_, tty_;
   std::uint64_t total_, first_;
   double dt_;
   Clock::time_point start_, last_;
@@ -109,7 +112,7 @@ class RunLoop {
         setup_(setup),
         world_(setup.world),
         context_{options.threads, &log},
-        progress_(options.progress, setup.total_steps, setup.world->stepCount(), setup.dt) {}
+        progress_(options.progress, setup.total_steps, setup.world->stepCount(), setup.dt, setup.experiment != nullptr) {}
 
   RunRecord run() {
     record_.first_step = world_->stepCount();
