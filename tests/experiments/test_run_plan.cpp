@@ -239,7 +239,7 @@ TEST_CASE("samples: sweeps of the same variants on three samples merge into mean
   CHECK(table[3] == "0.3,3,0.53,0.0424264,0.5,0.56,2,0,3");
   const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(merged / "samples.json"));
   CHECK(j["samples"][2]["label"] == "third");
-  CHECK(j["samples"][2]["runs_not_ok"] == 1);
+  CHECK(j["sets"][2]["runs_not_ok"] == 1);
   CHECK(j["variants"][1]["figures"]["restitution"]["per_sample"] == nlohmann::json::parse("[0.6, 0.64, null]"));
   CHECK(j["variants"][2]["figures"]["restitution"]["per_sample"] == nlohmann::json::parse("[0.5, null, 0.56]"));
   CHECK(j["variants"][0]["figures"]["jammed"]["per_sample"] == nlohmann::json::parse("[false, false, true]"));
@@ -265,9 +265,39 @@ TEST_CASE("samples: sweeps of the same variants on three samples merge into mean
   CHECK(rocklab::experiments::test::cliLogged(
             {"samples", (dir / "s1").string(), "--figure", "jammed", "--out", nothing.string()}, log) == 2);
   CHECK(log.find("allowed: a figure column with numbers: restitution") != std::string::npos);
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"samples", (dir / "s1").string(), "--over", "scene.seed", "--out", nothing.string()}, log) == 2);
+  CHECK(log.find("allowed: contact.damping_normal") != std::string::npos);
   CHECK(cli({"samples", (dir / "s1").string(), "--label", "a", "--label", "b", "--out", nothing.string()}) == 2);
   CHECK(cli({"samples", dir.string(), "--out", nothing.string()}) == 2);  // no plan.json
   CHECK_FALSE(fs::exists(nothing));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("samples --over scene.seed: the seeds one sweep varies are its samples", "[plan]") {
+  // damping 0.1: seeds 1-3 give 0.70, 0.72, 0.74 (mean 0.72, sd 0.02); 0.2: 0.60, 0.64, 0.62 (0.62, 0.02).
+  const fs::path dir = fresh("samples-over");
+  REQUIRE(cli({"sweep", "drop", "--vary", "contact.damping_normal=0.1,0.2", "--vary", "scene.seed=1,2,3", "--metric",
+               "restitution", "--plan", dir.string()}) == 0);
+  const char* figures[2][3] = {{"0.70", "0.72", "0.74"}, {"0.60", "0.64", "0.62"}};
+  for (int v = 0; v < 2; ++v)
+    for (int seed = 1; seed <= 3; ++seed) {
+      const fs::path run = dir / "runs" /
+                           ("contact.damping_normal=" + std::string(v ? "0.2" : "0.1") + "__scene.seed=" + std::to_string(seed));
+      fs::create_directories(run);
+      std::ofstream(run / "results.json") << "{\"status\": \"completed\", \"restitution\": " << figures[v][seed - 1] << "}";
+    }
+  REQUIRE(cli({"collect", dir.string()}) == 0);
+  REQUIRE(cli({"samples", dir.string(), "--over", "scene.seed", "--out", (dir / "merged").string()}) == 0);
+  const auto table = lines(dir / "merged" / "samples.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[0] == "contact.damping_normal,samples,restitution.mean,restitution.sd,restitution.min,restitution.max,"
+                    "restitution.n");
+  CHECK(table[1] == "0.1,3,0.72,0.02,0.7,0.74,3");
+  CHECK(table[2] == "0.2,3,0.62,0.02,0.6,0.64,3");
+  const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(dir / "merged" / "samples.json"));
+  CHECK(j["samples"][1]["label"] == "scene.seed = 2");
+  CHECK(j["variants"][1]["figures"]["restitution"]["per_sample"] == nlohmann::json::parse("[0.6, 0.64, 0.62]"));
   fs::remove_all(dir);
 }
 

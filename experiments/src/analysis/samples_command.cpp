@@ -153,17 +153,42 @@ json cellJson(FigureKind kind, const std::optional<std::string>& c) {
 /// The merged table: variants in the order the first sample's table lists them
 /// (then any only later samples ran), each figure's cells a sample.
 struct Merged {
-  std::vector<std::string> keys, figures;
-  std::vector<std::vector<std::string>> variants;                         // values in `keys` order
-  std::vector<std::size_t> rows;                                          // samples with a row
+  std::vector<std::string> keys, figures;                                   // keys: the varied ones but `over`
+  std::vector<std::string> sample_labels;                                   // a sample
+  std::vector<std::size_t> sample_set;                                      // its set
+  std::vector<std::vector<std::string>> variants;                           // values in `keys` order
+  std::vector<std::size_t> rows;                                            // samples with a row
   std::vector<std::vector<std::vector<std::optional<std::string>>>> cells;  // [figure][variant][sample]
-  std::vector<FigureKind> kinds;                                          // a figure
+  std::vector<FigureKind> kinds;                                            // a figure
 };
 
-Merged merge(const std::vector<SampleSet>& sets) {
+/// A sample a set, or with `over` (a varied key) a sample a value of it in each set.
+Merged merge(const std::vector<SampleSet>& sets, const std::string& over) {
   Merged m;
-  m.keys = sets.front().keys;
+  for (const std::string& k : sets.front().keys)
+    if (k != over) m.keys.push_back(k);
   m.figures = figureColumns(sets.front());
+  // The samples first (the cells are sized by them): the sets in order, each set's values
+  // of `over` in the order of its table.
+  std::vector<std::map<std::string, std::size_t>> sample_of(sets.size());  // [set][value of over]
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    const SweepTable& t = sets[s].table;
+    const std::size_t over_column = over.empty() ? 0 : t.column(over);
+    for (const std::vector<std::string>& row : t.rows) {
+      const std::string value = over.empty() || over_column >= row.size() ? std::string() : row[over_column];
+      if (!sample_of[s].emplace(value, m.sample_labels.size()).second) continue;
+      m.sample_labels.push_back(over.empty()   ? sets[s].label
+                                : sets.size() > 1 ? sets[s].label + ", " + over + " = " + value
+                                                  : over + " = " + value);
+      m.sample_set.push_back(s);
+    }
+    if (t.rows.empty() && over.empty()) {  // a set whose every run failed is still a sample
+      sample_of[s].emplace("", m.sample_labels.size());
+      m.sample_labels.push_back(sets[s].label);
+      m.sample_set.push_back(s);
+    }
+  }
+  const std::size_t samples = m.sample_labels.size();
   std::map<std::vector<std::string>, std::size_t> index;
   std::vector<std::vector<bool>> seen;  // [variant][sample]
   m.cells.assign(m.figures.size(), {});
@@ -172,6 +197,7 @@ Merged merge(const std::vector<SampleSet>& sets) {
     std::vector<std::size_t> key_columns, figure_columns;
     for (const std::string& k : m.keys) key_columns.push_back(t.column(k));
     for (const std::string& f : m.figures) figure_columns.push_back(t.column(f));
+    const std::size_t over_column = over.empty() ? 0 : t.column(over);
     for (const std::vector<std::string>& row : t.rows) {
       std::vector<std::string> values;
       for (std::size_t c : key_columns) values.push_back(c < row.size() ? row[c] : "");
@@ -179,15 +205,17 @@ Merged merge(const std::vector<SampleSet>& sets) {
       if (added) {
         m.variants.push_back(values);
         m.rows.push_back(0);
-        seen.emplace_back(sets.size(), false);
-        for (auto& figure : m.cells) figure.emplace_back(sets.size());
+        seen.emplace_back(samples, false);
+        for (auto& figure : m.cells) figure.emplace_back(samples);
       }
       const std::size_t v = it->second;
-      if (seen[v][s]) continue;  // a variant twice in one table: its first row
-      seen[v][s] = true;
+      const std::size_t sample =
+          sample_of[s].at(over.empty() || over_column >= row.size() ? std::string() : row[over_column]);
+      if (seen[v][sample]) continue;  // a variant twice in one sample: its first row
+      seen[v][sample] = true;
       ++m.rows[v];
       for (std::size_t f = 0; f < figure_columns.size(); ++f)
-        m.cells[f][v][s] = figure_columns[f] < row.size() ? row[figure_columns[f]] : std::string();
+        m.cells[f][v][sample] = figure_columns[f] < row.size() ? row[figure_columns[f]] : std::string();
     }
   }
   for (const auto& figure : m.cells) m.kinds.push_back(kindOf(figure));
@@ -252,8 +280,8 @@ PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
 
 }  // namespace
 
-int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_name, std::ostream& out,
-                      std::ostream& err) {
+int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_name, const std::string& over,
+                      std::ostream& out, std::ostream& err) {
   if (const std::string problem = detail::runLabelsProblem(o.runs.size(), o.labels.size()); !problem.empty()) {
     err << "error: samples: " << problem << "\n";
     return kExitBadInput;
@@ -267,7 +295,11 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
       sets.back().label = detail::runLabel(o.runs, o.labels, k);
     }
     checkSameShape(sets);
-    m = merge(sets);
+    const std::vector<std::string>& keys = sets.front().keys;
+    if (!over.empty() && std::find(keys.begin(), keys.end(), over) == keys.end())
+      throw SamplesInputError("--over " + over + ": not a key " + (sets.front().dir / "plan.json").string() +
+                              " varies (allowed: " + joined(keys) + ")");
+    m = merge(sets, over);
     for (std::size_t f = 0; f < m.figures.size(); ++f) {
       const bool any = std::any_of(m.cells[f].begin(), m.cells[f].end(), [](const auto& variant) {
         return std::any_of(variant.begin(), variant.end(), [](const auto& c) { return c && !c->empty(); });
@@ -340,10 +372,14 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
     csv << '\n';
     variants.push_back(row);
   }
-  json samples = json::array();
+  json set_list = json::array(), samples = json::array();
   for (const SampleSet& s : sets)
-    samples.push_back({{"label", s.label}, {"sweep", s.dir.string()}, {"runs_not_ok", s.table.not_ok}});
-  const json summary = {{"samples", samples},
+    set_list.push_back({{"label", s.label}, {"sweep", s.dir.string()}, {"runs_not_ok", s.table.not_ok}});
+  for (std::size_t k = 0; k < m.sample_labels.size(); ++k)
+    samples.push_back({{"label", m.sample_labels[k]}, {"set", m.sample_set[k]}});
+  const json summary = {{"sets", set_list},
+                        {"samples", samples},
+                        {"over", over.empty() ? json() : json(over)},
                         {"keys", m.keys},
                         {"statistics", "mean, sample standard deviation (n - 1), min, max over the samples that have "
                                        "the figure (n); true/false figures: how many of n are true"},
@@ -352,7 +388,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
     std::filesystem::create_directories(o.out_dir);
     detail::writeAtomically(o.out_dir / "samples.csv", csv.str());
     detail::writeAtomically(o.out_dir / "samples.json", detail::jsonText(summary));
-    if (figure) writePlot(samplesPlot(m, *figure, sets.size()), o.out_dir / "samples.png");
+    if (figure) writePlot(samplesPlot(m, *figure, m.sample_labels.size()), o.out_dir / "samples.png");
   } catch (const std::exception& e) {
     err << "error: samples: " << e.what() << '\n';
     return kExitFailed;

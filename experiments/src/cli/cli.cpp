@@ -64,6 +64,7 @@ Examples:
   rocklab products out/pbm out/bpm --label PBM --label BPM --out out/pbm-bpm   # product curves side by side
   rocklab profiles runs/inclined runs/vertical --out out/deposition   # chute marker profiles side by side
   rocklab samples runs/lab-s1 runs/lab-s2 runs/lab-s3 --out runs/lab   # a sweep's mean and scatter over samples
+  rocklab samples runs/chute --over scene.seed   # the same over the seeds one sweep varies
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -310,6 +311,8 @@ void addCommands(CLI::App& app, CliArgs& a) {
       "samples.csv, samples.json and samples.png");
   samples->add_option("--figure", a.figure,
                       "The sweep.csv column to plot and print (default: the first with numbers)");
+  samples->add_option("--over", a.group_by,
+                      "A key the sweeps vary whose values are samples (e.g. scene.seed; default: a sample a folder)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -586,7 +589,7 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     a.comparison.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / command : std::filesystem::path(a.out_dir);
     if (command == "products") return runProductsCommand(a.comparison, std::cout, std::cerr);
     if (command == "profiles") return runProfilesCommand(a.comparison, std::cout, std::cerr);
-    return runSamplesCommand(a.comparison, a.figure, std::cout, std::cerr);
+    return runSamplesCommand(a.comparison, a.figure, a.group_by, std::cout, std::cerr);
   }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);
   if (app.got_subcommand("report")) return detail::reportCommand(a.collect_dir, std::cerr);
