@@ -62,21 +62,45 @@ WallCalibration calibrateOnWall(const geometry::Camera& truth, const render::Ren
   WallCalibration out;
   render::Checkerboard& board = out.board;
   board.square = 1e-3 * std::floor(1e3 * 0.5 * std::min(view_w / (board.inner_cols + 3), view_h / (board.inner_rows + 3)));
-  if (!(board.square > 0.0)) throw std::runtime_error("calibration: the view of the wall is too small for a board");
   Mat3 upright;
   upright.col(0) = (truth.rotation.row(0).transpose() - n * n.dot(truth.rotation.row(0).transpose())).normalized();
   upright.col(2) = n;
   upright.col(1) = n.cross(upright.col(0));
-  const Vec3 half_grid(0.5 * (board.inner_cols - 1) * board.square, 0.5 * (board.inner_rows - 1) * board.square, 0.0);
-
-  std::vector<render::BoardPlacement> placements;
-  placements.push_back({upright, centre - upright * half_grid});  // flat on the wall: the reference
-  for (int k = 1; k < photos; ++k) {
-    const Tilt& t = kTilts[k - 1];
-    const Mat3 r = upright * rotationAbout(Vec3::UnitX(), t.about_x_deg) * rotationAbout(Vec3::UnitY(), t.about_y_deg);
-    const Vec3 c = eye + t.depth * (centre - eye) + upright * (t.depth * Vec3(t.shift_x * view_w, t.shift_y * view_h, 0.0));
-    placements.push_back({r, c - r * half_grid});
+  const auto placementsOf = [&](const render::Checkerboard& b) {
+    const Vec3 half_grid(0.5 * (b.inner_cols - 1) * b.square, 0.5 * (b.inner_rows - 1) * b.square, 0.0);
+    std::vector<render::BoardPlacement> list;
+    list.push_back({upright, centre - upright * half_grid});  // flat on the wall: the reference
+    for (int k = 1; k < photos; ++k) {
+      const Tilt& t = kTilts[k - 1];
+      const Mat3 r = upright * rotationAbout(Vec3::UnitX(), t.about_x_deg) * rotationAbout(Vec3::UnitY(), t.about_y_deg);
+      const Vec3 c = eye + t.depth * (centre - eye) + upright * (t.depth * Vec3(t.shift_x * view_w, t.shift_y * view_h, 0.0));
+      list.push_back({r, c - r * half_grid});
+    }
+    return list;
+  };
+  // Every photo must hold the board's squares whole (the detector needs the outer ones;
+  // of the white border around them, a part may be cut): the held and tilted boards come
+  // nearer the camera, and in a view less wide than the board a tilted one left it (16:9
+  // images lost their ninth photo, so the camera went uncalibrated). Smaller squares
+  // until every photo holds them.
+  const auto inView = [&](const render::Checkerboard& b, const render::BoardPlacement& p) {
+    const double lo = -b.square, hi_x = b.inner_cols * b.square, hi_y = b.inner_rows * b.square;
+    const double mx = 0.5, my = 0.5;  // px: the image's edge pixels
+    for (const Vec3& corner : {Vec3(lo, lo, 0), Vec3(hi_x, lo, 0), Vec3(lo, hi_y, 0), Vec3(hi_x, hi_y, 0)}) {
+      const Vec3 world = p.toWorld(corner);
+      if (!((world - eye).dot(axis) > 0.0)) return false;  // behind the camera
+      const geometry::Vec2 px = truth.project(world);
+      if (!(px.x() >= mx && px.x() <= truth.width - mx && px.y() >= my && px.y() <= truth.height - my)) return false;
+    }
+    return true;
+  };
+  std::vector<render::BoardPlacement> placements = placementsOf(board);
+  while (board.square >= 1e-3 &&
+         !std::all_of(placements.begin(), placements.end(), [&](const auto& p) { return inView(board, p); })) {
+    board.square = 1e-3 * std::floor(1e3 * 0.9 * board.square);
+    placements = placementsOf(board);
   }
+  if (!(board.square >= 1e-3)) throw std::runtime_error("calibration: the view of the wall is too small for a board");
   render::Renderer renderer(truth, options);
   std::vector<cv::Mat> images;
   for (const render::BoardPlacement& p : placements) images.push_back(renderer.render(render::checkerboardFrame(board, p)));
