@@ -16,9 +16,11 @@
 #   sizes  small: N = 2000 only (clumps: 1,700 clumps); full (default): N = 2000, 16000, 54000
 #          (clumps: 1,700 and 12,000 clumps, 6,800 and 48,000 balls)
 #   OUTDIR logs and results (default: a new temporary directory)
-# Needs: a built rocklab (bash scripts/setup.sh) and, for the peer, `apt-get install
-# --no-install-recommends liggghts` (with its recommends apt removes libvtk9-dev for
-# ParaView, and rocklab no longer configures).
+# Needs: a built rocklab (bash scripts/setup.sh). The peer, LIGGGHTS 3.8 and mpirun, is
+# installed where missing by scripts/install-peer.sh (Debian's package without its
+# recommends, which would remove libvtk9-dev for ParaView; it refuses any install that
+# removes a package and checks that rocklab still configures); ROCKLAB_BENCH_PEER=skip
+# runs rocklab alone.
 # Both engines run the same lattice, walls, contact law (linear, 1e9 N/m per contact,
 # friction 0.37, tangential history, no damping), dt = 1e-6 s, skin 2 mm and step count.
 # The clumps scene has the same clump (members, mass, principal moments), box, insertion region,
@@ -35,7 +37,13 @@ out=${3:-$(mktemp -d)}
 mkdir -p "$out"
 echo "logs in $out" >&2
 have_peer=1
-command -v liggghts >/dev/null && command -v mpirun >/dev/null || { have_peer=0; echo "liggghts not installed: peer columns empty" >&2; }
+case $which_scenes in all|settle|dense|clumps)  # the scenes with a peer: install it (ROCKLAB_BENCH_PEER=skip: don't)
+  if ! { command -v liggghts >/dev/null && command -v mpirun >/dev/null; }; then
+    if [ "${ROCKLAB_BENCH_PEER:-install}" = skip ] || ! "$root/scripts/install-peer.sh"; then
+      have_peer=0; echo "liggghts not installed: peer columns empty" >&2
+    fi
+  fi ;;
+esac
 
 calc() {  # calc EXPR -> the value with a leading zero (bc prints .5, which TOML refuses)
   printf '%.17g' "$(echo "$1" | bc -l)"

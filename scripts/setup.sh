@@ -4,16 +4,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-packages=(build-essential cmake pkg-config
-  libeigen3-dev libosmesa6-dev libopencv-dev libassimp-dev libvtk9-dev libhdf5-dev catch2
-  libcgal-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libspdlog-dev libfmt-dev ffmpeg parallel
-  gnuplot-nox fonts-dejavu-core  # plots (PNG + SVG): experiments/src/analysis/plot.h
-  libxml2-utils)  # xmllint: the report tests parse report.html
-
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
+source "$root/scripts/packages.sh"
+mapfile -t missing < <(rocklab_missing_packages)
 if ((${#missing[@]})); then
   echo "rocklab: installing ${#missing[@]} missing Debian packages: ${missing[*]}" >&2
   sudo_cmd=""
