@@ -301,6 +301,34 @@ TEST_CASE("samples --over scene.seed: the seeds one sweep varies are its samples
   fs::remove_all(dir);
 }
 
+TEST_CASE("samples.png leaves out a group in which no sample has the figure (every case jammed)", "[plan]") {
+  // Two groups by the time-step factor; at 0.2 every run lacks the figure, as a zoned-chute
+  // CSS whose every case jammed has no clearance time.
+  const fs::path dir = fresh("samples-empty-group");
+  REQUIRE(cli({"sweep", "drop", "--vary", "contact.damping_normal=0.1,0.2", "--vary", "timestep.safety_factor=0.4,0.2",
+               "--vary", "scene.seed=1,2", "--metric", "restitution", "--plan", dir.string()}) == 0);
+  for (const char* damping : {"0.1", "0.2"})
+    for (const char* factor : {"0.4", "0.2"})
+      for (const char* seed : {"1", "2"}) {
+        const fs::path run = dir / "runs" /
+                             (std::string("contact.damping_normal=") + damping + "__timestep.safety_factor=" + factor +
+                              "__scene.seed=" + seed);
+        fs::create_directories(run);
+        std::ofstream(run / "results.json")
+            << "{\"status\": \"completed\"" << (factor[2] == '4' ? std::string(", \"restitution\": 0.") + seed : "")
+            << "}";
+      }
+  REQUIRE(cli({"collect", dir.string()}) == 0);
+  REQUIRE(cli({"samples", dir.string(), "--over", "scene.seed", "--out", (dir / "merged").string()}) == 0);
+  const std::string plotted = rocklab::experiments::test::slurp(dir / "merged" / "samples.plot.csv");
+  CHECK(plotted.find("timestep.safety_factor = 0.4: each sample") != std::string::npos);
+  CHECK(plotted.find("timestep.safety_factor = 0.2") == std::string::npos);
+  const auto table = lines(dir / "merged" / "samples.csv");
+  REQUIRE(table.size() == 5);
+  CHECK(table[2] == "0.1,0.2,2,,,,,0");  // the empty group is still in the table, n = 0
+  fs::remove_all(dir);
+}
+
 TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and says so", "[plan][cli]") {
   // Slurm's SIGTERM or a `kill` reaches the sweep's process only (its runs are process
   // groups of their own); it passes the stop on, so no run goes on orphaned.

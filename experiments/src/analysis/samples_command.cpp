@@ -11,9 +11,11 @@
 #include <stdexcept>
 
 #include "analysis/plot.h"
+#include "analysis/sample_statistics.h"
 #include "analysis/sweep_table.h"
 #include "common/atomic_file.h"
 #include "common/csv.h"
+#include "common/joined_text.h"
 #include "common/json_text.h"
 #include "rocklab/experiments/run.h"
 #include "sets/plan_file.h"
@@ -70,9 +72,7 @@ std::vector<std::string> figureColumns(const SampleSet& s) {
 
 std::string joined(std::vector<std::string> names) {
   std::sort(names.begin(), names.end());
-  std::string s;
-  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s.empty() ? "none" : s;
+  return names.empty() ? "none" : detail::joinedText(names);
 }
 
 /// The sets must vary the same keys and tabulate the same figures (in any order).
@@ -127,16 +127,11 @@ Statistics statisticsOf(FigureKind kind, const std::vector<std::optional<std::st
     if (kind == FigureKind::Text && std::find(st.texts.begin(), st.texts.end(), *c) == st.texts.end())
       st.texts.push_back(*c);
   }
-  if (v.empty()) return st;
-  st.mean = 0.0;
-  for (double x : v) st.mean += x / static_cast<double>(v.size());
-  st.min = *std::min_element(v.begin(), v.end());
-  st.max = *std::max_element(v.begin(), v.end());
-  if (v.size() > 1) {
-    double ss = 0.0;
-    for (double x : v) ss += (x - st.mean) * (x - st.mean);
-    st.sd = std::sqrt(ss / static_cast<double>(v.size() - 1));
-  }
+  const SampleStatistics s = sampleStatistics(v);
+  st.mean = s.mean;
+  st.sd = s.sd;
+  st.min = s.min;
+  st.max = s.max;
   return st;
 }
 
@@ -160,6 +155,7 @@ struct Merged {
   std::vector<std::size_t> rows;                                            // samples with a row
   std::vector<std::vector<std::vector<std::optional<std::string>>>> cells;  // [figure][variant][sample]
   std::vector<FigureKind> kinds;                                            // a figure
+  std::vector<std::vector<Statistics>> stats;                               // [figure][variant]
 };
 
 /// A sample a set, or with `over` (a varied key) a sample a value of it in each set.
@@ -218,7 +214,11 @@ Merged merge(const std::vector<SampleSet>& sets, const std::string& over) {
         m.cells[f][v][sample] = figure_columns[f] < row.size() ? row[figure_columns[f]] : std::string();
     }
   }
-  for (const auto& figure : m.cells) m.kinds.push_back(kindOf(figure));
+  for (const auto& figure : m.cells) {
+    m.kinds.push_back(kindOf(figure));
+    std::vector<Statistics>& per_variant = m.stats.emplace_back();
+    for (const auto& cells : figure) per_variant.push_back(statisticsOf(m.kinds.back(), cells));
+  }
   return m;
 }
 
@@ -267,10 +267,10 @@ PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
           points.y.push_back(*y);
           ++have;
         }
-      const Statistics st = statisticsOf(FigureKind::Number, cells);
       mean.x.push_back(xOf(v));
-      mean.y.push_back(have == samples ? st.mean : NAN);  // a line break where a sample has none
+      mean.y.push_back(have == samples ? m.stats[figure][v].mean : NAN);  // a line break where a sample has none
     }
+    if (points.x.empty()) continue;  // no sample has the figure (every case jammed): no empty legend entry
     points.colour = mean.colour = static_cast<int>(g);
     spec.series.push_back(points);
     spec.series.push_back(mean);
@@ -345,7 +345,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
     }
     csv << m.rows[v];
     for (std::size_t f = 0; f < m.figures.size(); ++f) {
-      const Statistics st = statisticsOf(m.kinds[f], m.cells[f][v]);
+      const Statistics& st = m.stats[f][v];
       json entry = {{"n", st.n}, {"per_sample", json::array()}};
       for (const auto& c : m.cells[f][v]) entry["per_sample"].push_back(cellJson(m.kinds[f], c));
       switch (m.kinds[f]) {
@@ -405,17 +405,14 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
     for (const std::string& value : m.variants[v]) out << std::left << std::setw(24) << value << ' ';
     out << std::right << std::setw(8) << m.rows[v];
     if (figure) {
-      const Statistics st = statisticsOf(FigureKind::Number, m.cells[*figure][v]);
+      const Statistics& st = m.stats[*figure][v];
       if (st.n == 0) out << "  - (0)";
       else
         out << "  " << formatted(st.mean) << " ± " << (st.n > 1 ? formatted(st.sd) : "-") << " ["
             << formatted(st.min) << ", " << formatted(st.max) << "] (" << st.n << ")";
     }
     for (std::size_t f = 0; f < m.figures.size(); ++f)
-      if (m.kinds[f] == FigureKind::Flag) {
-        const Statistics st = statisticsOf(FigureKind::Flag, m.cells[f][v]);
-        out << "  " << st.true_count << '/' << st.n;
-      }
+      if (m.kinds[f] == FigureKind::Flag) out << "  " << m.stats[f][v].true_count << '/' << m.stats[f][v].n;
     out << '\n';
   }
   for (const SampleSet& s : sets)

@@ -9,6 +9,7 @@
 
 #include "analysis/batch_curves.h"
 #include "analysis/plot.h"
+#include "analysis/sample_statistics.h"
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
 #include "common/atomic_file.h"
@@ -27,12 +28,7 @@ std::string text(double v) {
 }
 
 /// The mean of the values; NaN for none.
-double meanOf(const std::vector<double>& v) {
-  if (v.empty()) return NAN;
-  double sum = 0;
-  for (double x : v) sum += x;
-  return sum / static_cast<double>(v.size());
-}
+double meanOf(const std::vector<double>& v) { return sampleStatistics(v).mean; }
 
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -99,13 +95,8 @@ int strengthGroupsCommand(const std::filesystem::path& dir, const StrengthGroupO
   for (const Group& g : groups) {
     nlohmann::json row{{"value", g.value}, {"runs", g.strengths.size()}};
     std::vector<std::string> cells{g.value, std::to_string(g.strengths.size())};
-    const double mean = meanOf(g.strengths);
-    double sd = NAN;
-    if (g.strengths.size() > 1) {
-      double ss = 0;
-      for (double s : g.strengths) ss += (s - mean) * (s - mean);
-      sd = std::sqrt(ss / static_cast<double>(g.strengths.size() - 1));
-    }
+    const SampleStatistics stats = sampleStatistics(g.strengths);
+    const double mean = stats.mean, sd = stats.sd;
     row["mean_MPa"] = mean;
     row["stddev_MPa"] = sd;
     row["cov"] = sd / mean;

@@ -1,5 +1,7 @@
 #include "weibull.h"
 
+#include "sample_statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -63,12 +65,10 @@ WeibullFit fitWeibull(std::vector<double> strengths) {
   fit.modulus = line.slope;
   fit.sigma0 = std::exp(-line.intercept / line.slope);  // y = m ln s - m ln s0 = 0
   fit.r2 = line.r2;
-  double sum = 0, sum2 = 0;
-  for (double v : strengths) sum += v;
-  fit.mean = sum / n;
-  for (double v : strengths) sum2 += (v - fit.mean) * (v - fit.mean);
-  fit.stddev = std::sqrt(sum2 / (n - 1.0));
-  fit.cov = fit.stddev / fit.mean;
+  const SampleStatistics stats = sampleStatistics(strengths);
+  fit.mean = stats.mean;
+  fit.stddev = stats.sd;
+  fit.cov = stats.cov();
   fit.sorted = std::move(strengths);
   return fit;
 }

@@ -1,6 +1,8 @@
 // The output folder of a run made ready (output_folder.h).
 #include "run/output_folder.h"
 
+#include "common/joined_text.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,12 +29,6 @@ std::vector<std::string> earlierRunMarks(const fs::path& dir) {
   for (const char* mark : kRunMarks)
     if (fs::exists(fs::symlink_status(dir / mark, ec))) marks.emplace_back(mark);
   return marks;
-}
-
-std::string joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
-  return text;
 }
 
 /// Whether `entry` is something a run writes: its marks, the cameras' frames/, and
@@ -88,7 +84,7 @@ int prepareOutputFolder(const RunOptions& options, std::ostream& log) {
     }
     const std::vector<std::string> marks = earlierRunMarks(dir);
     if (!marks.empty() && options.earlier_run == EarlierRun::Refuse) {
-      log << "error: " << where << " holds an earlier run (" << joined(marks)
+      log << "error: " << where << " holds an earlier run (" << joinedText(marks)
           << "); give --overwrite to replace it (its files are removed first), or another --out\n";
       return kExitBadInput;
     }
@@ -97,7 +93,7 @@ int prepareOutputFolder(const RunOptions& options, std::ostream& log) {
         log << "error: cannot clear the earlier run in " << where << ": " << why << "\n";
         return kExitBadInput;
       }
-      log << "rocklab: " << where << ": the earlier run (" << joined(marks) << ") removed (--overwrite)\n";
+      log << "rocklab: " << where << ": the earlier run (" << joinedText(marks) << ") removed (--overwrite)\n";
     }
   }
   fs::create_directories(dir, ec);

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "agglomerate/agglomerate_library.h"
+#include "common/joined_text.h"
 #include "rocklab/experiments/scene.h"
 #include "scene/toml_reader.h"
 
@@ -663,9 +664,7 @@ std::string joined(const std::vector<std::string>& values, const std::string& se
   std::vector<std::string> seen;
   for (const auto& v : values)
     if (!v.empty() && std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
-  std::string out;
-  for (const auto& v : seen) out += (out.empty() ? "" : sep) + v;
-  return out;
+  return detail::joinedText(seen, sep);
 }
 
 std::string heading(const std::string& table) {

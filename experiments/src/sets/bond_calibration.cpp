@@ -11,6 +11,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "analysis/sample_statistics.h"
 #include "analysis/sweep_table.h"
 #include "analysis/weibull.h"
 #include "analysis/weibull_report.h"
@@ -72,11 +73,9 @@ int runTrial(const SweepOptions& runs, double bond, const std::vector<std::strin
     r.wall_s += SweepTable::numberIn(row, wall).value_or(0.0);
   }
   if (r.strengths_Pa.size() != seeds.size()) return kExitRunsFailed;
-  double sum = 0, sum2 = 0;
-  for (double v : r.strengths_Pa) sum += v;
-  r.mean_strength_Pa = sum / static_cast<double>(seeds.size());
-  for (double v : r.strengths_Pa) sum2 += (v - r.mean_strength_Pa) * (v - r.mean_strength_Pa);
-  if (seeds.size() > 1) r.cov = std::sqrt(sum2 / static_cast<double>(seeds.size() - 1)) / r.mean_strength_Pa;
+  const SampleStatistics stats = sampleStatistics(r.strengths_Pa);
+  r.mean_strength_Pa = stats.mean;
+  if (stats.n > 1) r.cov = stats.cov();
   return kExitOk;
 }
 

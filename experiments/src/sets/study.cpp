@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/json_text.h"
 #include "analysis/plot.h"
+#include "analysis/sample_statistics.h"
 #include "sets/run_plan.h"
 #include "sets/run_set.h"
 #include "sets/study_report.h"
@@ -188,15 +189,10 @@ std::vector<Row> rowsOf(const StudyOptions& o, const std::vector<Variant>& done)
     }
     p.runs = static_cast<int>(figures.size());
     p.ok = !figures.empty() && failure.empty();
-    p.figure = figures.empty() ? kNaN : 0.0;
-    for (double f : figures) p.figure += f / static_cast<double>(figures.size());
+    const SampleStatistics stats = sampleStatistics(figures);
+    p.figure = stats.mean;
     p.wall_s = figures.empty() ? kNaN : wall / static_cast<double>(figures.size());  // per run
-    p.scatter = kNaN;
-    if (figures.size() > 1) {
-      double ss = 0.0;
-      for (double f : figures) ss += (f - p.figure) * (f - p.figure);
-      p.scatter = std::sqrt(ss / static_cast<double>(figures.size() - 1));
-    }
+    p.scatter = stats.sd;
     if (failure.empty()) row.status = "ok";
     else if (per > 1) row.status = std::to_string(figures.size()) + " of " + std::to_string(row.members.size()) + " ok; " + failure;
     else row.status = failure;
