@@ -37,11 +37,11 @@ out=${3:-$(mktemp -d)}
 mkdir -p "$out"
 echo "logs in $out" >&2
 have_peer=1
-case $which_scenes in all|settle|dense|clumps)  # the scenes with a peer: install it (ROCKLAB_BENCH_PEER=skip: don't)
-  if ! { command -v liggghts >/dev/null && command -v mpirun >/dev/null; }; then
-    if [ "${ROCKLAB_BENCH_PEER:-install}" = skip ] || ! "$root/scripts/install-peer.sh"; then
-      have_peer=0; echo "liggghts not installed: peer columns empty" >&2
-    fi
+case $which_scenes in all|settle|dense|clumps)  # the scenes with a peer: install it where missing
+  if [ "${ROCKLAB_BENCH_PEER:-install}" = skip ]; then
+    have_peer=0; echo "ROCKLAB_BENCH_PEER=skip: rocklab alone, peer columns empty" >&2
+  elif ! { command -v liggghts >/dev/null && command -v mpirun >/dev/null; } && ! "$root/scripts/install-peer.sh"; then
+    have_peer=0; echo "liggghts not installed: peer columns empty" >&2
   fi ;;
 esac
 

@@ -56,37 +56,58 @@ inline Vec3 angularMomentum(const Quat& q, const Vec3& inertia, const Vec3& omeg
   }
 }
 
-/// Rotates q over `dt` as a free body with world angular momentum L.
-inline void rotateFree(Quat& q, const Vec3& inertia, const Vec3& L, double dt) {
-  Vec3 pi = q.conjugate() * L;  // body-frame angular momentum
-  const Vec3 rate = inertia.cwiseInverse();  // the divisions out of the chain of sub-rotations
-  double qw = q.w(), qx = q.x(), qy = q.y(), qz = q.z();
-  auto about = [&](int axis, double tau) {
-    // The flow of pi_k^2 / (2 I_k): spin about body axis k at rate pi_k / I_k;
-    // the body-frame momentum turns the other way so that L = R pi is fixed.
-    const double angle = tau * pi[axis] * rate[axis];
-    double s, c;
-    sinCos(0.5 * angle, s, c);
-    // q = q * (c, s e_k), written out: the right factor has one vector component.
-    const double w = qw, x = qx, y = qy, z = qz;
-    switch (axis) {
-      case 0: qw = w * c - x * s; qx = w * s + x * c; qy = y * c + z * s; qz = z * c - y * s; break;
-      case 1: qw = w * c - y * s; qx = x * c - z * s; qy = w * s + y * c; qz = z * c + x * s; break;
-      default: qw = w * c - z * s; qx = x * c + y * s; qy = y * c - x * s; qz = w * s + z * c; break;
+/// Rotates B bodies over `dt` as free bodies with world angular momenta L[l]:
+/// q[l] in place. Each body's arithmetic is exactly that of B = 1 (so results do
+/// not depend on how bodies are batched); the B chains of dependent operations are
+/// interleaved, a sub-rotation of every body before the next, so that the core
+/// overlaps them: one body's chain alone leaves it waiting on each result.
+template <int B>
+[[gnu::always_inline]] inline void rotateFreeBatch(Quat* q, const Vec3* inertia, const Vec3* L, double dt) {
+  double qw[B], qx[B], qy[B], qz[B], pi[3][B], rate[3][B];
+  for (int l = 0; l < B; ++l) {
+    const Vec3 body = q[l].conjugate() * L[l];  // body-frame angular momentum
+    for (int a = 0; a < 3; ++a) {
+      pi[a][l] = body[a];
+      rate[a][l] = 1.0 / inertia[l][a];  // the divisions out of the chain of sub-rotations
     }
+    qw[l] = q[l].w();
+    qx[l] = q[l].x();
+    qy[l] = q[l].y();
+    qz[l] = q[l].z();
+  }
+  auto about = [&](const int axis, const double tau) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    const double ca = 1.0 - 2.0 * s * s, sa = 2.0 * s * c;  // the full angle's, from the half's
-    const double pa = pi[a], pb = pi[b];
-    pi[a] = ca * pa + sa * pb;
-    pi[b] = -sa * pa + ca * pb;
+    for (int l = 0; l < B; ++l) {
+      // The flow of pi_k^2 / (2 I_k): spin about body axis k at rate pi_k / I_k;
+      // the body-frame momentum turns the other way so that L = R pi is fixed.
+      const double angle = tau * pi[axis][l] * rate[axis][l];
+      double s, c;
+      sinCos(0.5 * angle, s, c);
+      // q = q * (c, s e_k), written out: the right factor has one vector component.
+      const double w = qw[l], x = qx[l], y = qy[l], z = qz[l];
+      switch (axis) {
+        case 0: qw[l] = w * c - x * s; qx[l] = w * s + x * c; qy[l] = y * c + z * s; qz[l] = z * c - y * s; break;
+        case 1: qw[l] = w * c - y * s; qx[l] = x * c - z * s; qy[l] = w * s + y * c; qz[l] = z * c + x * s; break;
+        default: qw[l] = w * c - z * s; qx[l] = x * c + y * s; qy[l] = y * c - x * s; qz[l] = w * s + z * c; break;
+      }
+      const double ca = 1.0 - 2.0 * s * s, sa = 2.0 * s * c;  // the full angle's, from the half's
+      const double pa = pi[a][l], pb = pi[b][l];
+      pi[a][l] = ca * pa + sa * pb;
+      pi[b][l] = -sa * pa + ca * pb;
+    }
   };
   about(0, 0.5 * dt);
   about(1, 0.5 * dt);
   about(2, dt);
   about(1, 0.5 * dt);
   about(0, 0.5 * dt);
-  q = Quat(qw, qx, qy, qz);
-  q.normalize();
+  for (int l = 0; l < B; ++l) {
+    q[l] = Quat(qw[l], qx[l], qy[l], qz[l]);
+    q[l].normalize();
+  }
 }
+
+/// Rotates q over `dt` as a free body with world angular momentum L.
+inline void rotateFree(Quat& q, const Vec3& inertia, const Vec3& L, double dt) { rotateFreeBatch<1>(&q, &inertia, &L, dt); }
 
 }  // namespace rocklab::sim::detail

@@ -50,34 +50,49 @@ void World::Impl::clumpLoad(std::size_t c, Vec3& force, Vec3& torque) const {
 void World::Impl::integrateClumps(double h, StepChecks& merged) {
   ClumpState& k = p.clumps;
   const double alpha = model.contact.local_damping;
+  // Bodies go in blocks of kBatch so that their free rotations run interleaved
+  // (rotateFreeBatch): each body's arithmetic is the same as alone.
+  constexpr std::size_t kBatch = 4;
+  const std::size_t n = k.size(), blocks = (n + kBatch - 1) / kBatch;
 #pragma omp parallel num_threads(teamSize())
   {
     StepChecks local;
 #pragma omp for schedule(static)
-    for (std::size_t c = 0; c < k.size(); ++c) {
-      Vec3 f, t;
-      clumpLoad(c, f, t);
-      f += gravity * k.mass[c];
-      if (alpha > 0) {
-        // Local damping (Eq 2-15, sign form) on the body's generalised force.
-        const Vec3 w = detail::angularVelocity(k.orientation[c], k.inertia[c], k.angular_momentum[c]);
-        for (int a = 0; a < 3; ++a) {
-          f[a] -= alpha * std::abs(f[a]) * ((k.velocity[c][a] > 0) - (k.velocity[c][a] < 0));
-          t[a] -= alpha * std::abs(t[a]) * ((w[a] > 0) - (w[a] < 0));
+    for (std::size_t block = 0; block < blocks; ++block) {
+      const std::size_t first = block * kBatch, count = std::min(kBatch, n - first);
+      Quat q[kBatch];
+      Vec3 L[kBatch];
+      for (std::size_t l = 0; l < count; ++l) {
+        const std::size_t c = first + l;
+        Vec3 f, t;
+        clumpLoad(c, f, t);
+        f += gravity * k.mass[c];
+        if (alpha > 0) {
+          // Local damping (Eq 2-15, sign form) on the body's generalised force.
+          const Vec3 w = detail::angularVelocity(k.orientation[c], k.inertia[c], k.angular_momentum[c]);
+          for (int a = 0; a < 3; ++a) {
+            f[a] -= alpha * std::abs(f[a]) * ((k.velocity[c][a] > 0) - (k.velocity[c][a] < 0));
+            t[a] -= alpha * std::abs(t[a]) * ((w[a] > 0) - (w[a] < 0));
+          }
         }
+        // Formed and checked in registers, then stored (as integrate() does for a ball).
+        const Vec3 v = k.velocity[c] + (h / k.mass[c]) * f;  // Eq 2-11 for the body
+        L[l] = k.angular_momentum[c] + h * t;                 // Eq 2-45
+        const Vec3 x = k.position[c] + dt * v;                // Eq 2-13
+        if (!x.allFinite() || !v.allFinite() || !L[l].allFinite()) local.non_finite = true;
+        k.velocity[c] = v;
+        k.angular_momentum[c] = L[l];
+        k.position[c] = x;
+        q[l] = k.orientation[c];
       }
-      // Formed and checked in registers, then stored (as integrate() does for a ball).
-      const Vec3 v = k.velocity[c] + (h / k.mass[c]) * f;  // Eq 2-11 for the body
-      const Vec3 L = k.angular_momentum[c] + h * t;         // Eq 2-45
-      const Vec3 x = k.position[c] + dt * v;                // Eq 2-13
-      if (!x.allFinite() || !v.allFinite() || !L.allFinite()) local.non_finite = true;
-      k.velocity[c] = v;
-      k.angular_momentum[c] = L;
-      k.position[c] = x;
-      Quat q = k.orientation[c];
-      detail::rotateFree(q, k.inertia[c], L, dt);
-      k.orientation[c] = q;
-      local.max_disp2 = std::max(local.max_disp2, placeMembers(c, q, x, v, L));
+      if (count == kBatch) detail::rotateFreeBatch<kBatch>(q, &k.inertia[first], L, dt);
+      else
+        for (std::size_t l = 0; l < count; ++l) detail::rotateFree(q[l], k.inertia[first + l], L[l], dt);
+      for (std::size_t l = 0; l < count; ++l) {
+        const std::size_t c = first + l;
+        k.orientation[c] = q[l];
+        local.max_disp2 = std::max(local.max_disp2, placeMembers(c, q[l], k.position[c], k.velocity[c], L[l]));
+      }
     }
 #pragma omp critical
     mergeChecks(merged, local);
