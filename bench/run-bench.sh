@@ -3,11 +3,12 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|clumps|grid|render|track|memory|all] [small|full] [OUTDIR]
+# Usage: bench/run-bench.sh [settle|dense|clumps|grid|order|render|track|memory|all] [small|full] [OUTDIR]
 #   scene  settle (contact-sparse), dense (contact-rich), clumps (the chute's four-ball clump
 #          landing in a box, then sheared by a sliding floor; ball-steps/s, i.e. clump members,
 #          and member contacts per clump in both engines as the check), grid (7:1 size ratio:
-#          multi-level against single-level neighbour grid, rocklab only), render
+#          multi-level against single-level neighbour grid, rocklab only), order (the dense
+#          lattice in lattice order against the same spheres shuffled in memory, rocklab only), render
 #          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
 #          1280x1024, rocklab only), track (marker detection + linking frames/s on
 #          the same frames), memory (rocklab's peak-RSS growth per sphere on settle
@@ -178,6 +179,32 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
       "$( [ -z "$l1" ] || printf %.3g "$l1")" "$( [ -z "$l2" ] || printf %.3g "$l2")" \
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$touch_r" \
       "$( [ -z "$touch_l" ] || printf %.3g "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
+  done
+fi
+
+# Memory order: the dense lattice (N = 16,000, or 2,000 with small) given as a list of its
+# positions, once in lattice order and once shuffled (fixed seed): the same spheres, contacts
+# and steps, so the ratio is what neighbours scattered in memory cost (rocklab only, one thread).
+if [ "$which_scenes" = all ] || [ "$which_scenes" = order ]; then
+  printf '\norder,N,steps,particle_steps_per_s\n'
+  read -r nx nz steps < <([ "$sizes" = full ] && echo "20 10 1500" || echo "10 5 6000")
+  for order in lattice shuffled; do
+    scene="$out/order-$order.toml"
+    # The dense scene up to its particles, the box for nx x nx x nz cells, then the list.
+    sed '/^\[\[particles\]\]/,$d' "$root/bench/scenes/dense.toml" >"$scene"
+    awk -v nx=$nx -v nz=$nz -v order=$order 'BEGIN {
+      a = 0.0282842712474619; split("0 0 0 0.5 0.5 0 0.5 0 0.5 0 0.5 0.5", b, " ")
+      for (k = 0; k < nz; ++k) for (j = 0; j < nx; ++j) for (i = 0; i < nx; ++i) for (q = 0; q < 4; ++q)
+        p[n++] = sprintf("[%.17g,%.17g,%.17g]", (i + 0.25 + b[3*q+1]) * a, (j + 0.25 + b[3*q+2]) * a, (k + 0.25 + b[3*q+3]) * a)
+      if (order == "shuffled") { srand(1); for (m = n - 1; m > 0; --m) { r = int(rand() * (m + 1)); t = p[m]; p[m] = p[r]; p[r] = t } }
+      print "[[particles]]\ntype = \"list\"\nmaterial = \"ball\"\nradius = 0.01\npositions = ["
+      for (m = 0; m < n; ++m) print p[m] (m < n - 1 ? "," : "]")
+      print "[output]\nhdf5 = false\ncheckpoint = false"
+    }' >>"$scene"
+    dir="$out/rocklab-order-$order"
+    "$rocklab" run "$scene" --out "$dir" --overwrite --threads 1 --quiet --set scene.steps=$steps \
+      --set "walls.0.max=[$(calc "($nx-0.25)*0.0282842712474619+0.01"),$(calc "($nx-0.25)*0.0282842712474619+0.01"),$(calc "($nz+1)*0.0282842712474619")]" >"$dir.log" 2>&1
+    printf '%s,%s,%s,%.3g\n' $order "$(json "$dir/results.json" particles)" $steps "$(json "$dir/results.json" particle_steps_per_s)"
   done
 fi
 
