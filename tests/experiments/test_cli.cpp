@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <thread>
@@ -182,6 +184,15 @@ TEST_CASE("Ctrl-C stops cleanly: exit 130 and readable run.h5 - checkpoint and r
   CHECK(r2["status"] == "completed");
   CHECK(r2["steps"].get<std::uint64_t>() > cp.state.step);
   CHECK(r2["simulated_time_s"].get<double>() == Approx(more).margin(2e-6));
+  // The wall time goes on with the run: the checkpoint holds what the first run took
+  // up to it, the restart reports it beside its own.
+  REQUIRE(std::isfinite(cp.run_wall_time_s));
+  CHECK(cp.run_wall_time_s > 0);
+  CHECK(cp.run_wall_time_s <= r["wall_time_s"]["total"].get<double>());
+  CHECK(r["wall_time_s"]["earlier_runs"] == 0.0);  // a new run continues none
+  CHECK(r2["wall_time_s"]["earlier_runs"].get<double>() == cp.run_wall_time_s);
+  CHECK(r2["wall_time_s"]["all_runs"].get<double>() ==
+        Approx(cp.run_wall_time_s + r2["wall_time_s"]["total"].get<double>()).epsilon(1e-12));
   fs::remove_all(out);
   fs::remove_all(out2);
 }

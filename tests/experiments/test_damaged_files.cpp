@@ -140,6 +140,9 @@ TEST_CASE("restart refuses a damaged checkpoint: exit 2, the file, dataset and r
          H5::H5File(copy.string(), H5F_ACC_RDWR).openDataSet("/particles/radius").write(r.data(), H5::PredType::NATIVE_DOUBLE);
        },
        "dataset /particles/radius: checksum mismatch"},
+      {"a negative wall time of the earlier runs",
+       [&] { rewrite(copy, "/run_wall_time_s", std::vector<double>{-1.0}, H5::PredType::NATIVE_DOUBLE); },
+       "dataset /run_wall_time_s: -1.000000 s (allowed: a finite number >= 0)"},
       {"dt 0 in a file without checksums (was 2^63 steps)",
        [&] {
          H5::H5File f(copy.string(), H5F_ACC_RDWR);

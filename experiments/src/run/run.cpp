@@ -33,6 +33,7 @@ int runWith(const Scene& scene, const RunOptions& options, std::ostream& log, Re
   detail::RunTimes times{detail::Clock::now(), {}};
   clearStopRequest();
   detail::RunSetup setup;
+  setup.started = times.start;
   if (const int rc = detail::setUpRun(scene, options, log, setup); rc != kExitOk) return rc;
   release();
   times.setup_done = detail::Clock::now();

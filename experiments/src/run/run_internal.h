@@ -43,6 +43,11 @@ struct RunSetup {
   std::uint64_t total_steps = 0;
   // Steps between trajectory frames, energy rows and checkpoints (0 = none).
   std::uint64_t frame_every = 0, energy_every = 0, checkpoint_every = 0;
+  // The run's clock (run.cpp sets it first) and the wall time of the runs a restart
+  // continues (s; 0 for a new run, NaN when the checkpoint did not say): checkpoints
+  // carry their sum on, results.json reports it.
+  Clock::time_point started = Clock::now();
+  double earlier_wall_s = 0.0;
 };
 
 /// checkpoint.h5's /experiment: CBOR of {experiment: the type that wrote it,

@@ -226,7 +226,7 @@ class RunLoop {
       experiment_state = nlohmann::json::to_cbor(
           {{"experiment", scene_.experiment_type}, {"format", kExperimentStateFormat}, {"state", experiment->saveState()}});
     sim::output::writeCheckpoint(options_.out_dir / "checkpoint.h5", world_->exportState(), scene_.text,
-                                 experiment_state);
+                                 experiment_state, setup_.earlier_wall_s + seconds(setup_.started, Clock::now()));
     record_.checkpoint_step = static_cast<std::int64_t>(world_->stepCount());
     record_.output_seconds += seconds(t0, Clock::now());
   }

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -20,6 +21,8 @@ namespace rocklab::experiments::detail {
 namespace {
 
 using json = nlohmann::json;
+
+json finiteOrNull(double v) { return std::isfinite(v) ? json(v) : json(); }
 
 std::string hex(std::uint64_t v) {
   std::ostringstream s;
@@ -146,10 +149,15 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   r["dt_s"] = setup.dt;
   r["simulated_time_s"] = world.time();
   r["timestep"] = timestepJson(setup, record);
+  const double total = seconds(times.start, Clock::now());
   r["wall_time_s"] = {{"setup", seconds(times.start, times.setup_done)},
                       {"stepping", stepping},
                       {"output", record.output_seconds},
-                      {"total", seconds(times.start, Clock::now())}};
+                      {"total", total},
+                      // A restart's own time is `total`; these count the runs it continues
+                      // too (their checkpoints carry it; null from a checkpoint that did not).
+                      {"earlier_runs", finiteOrNull(setup.earlier_wall_s)},
+                      {"all_runs", finiteOrNull(setup.earlier_wall_s + total)}};
   r["stage_seconds"] = stageSecondsJson(record);
   r["particle_steps_per_s"] =  // balls, members included
       stepping > 0 ? static_cast<double>(record.ball_steps) / stepping : 0.0;

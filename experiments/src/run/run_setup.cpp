@@ -65,6 +65,7 @@ int restartWorld(const Scene& scene, const RunOptions& options, std::ostream& lo
       }
     }
     world = std::make_unique<sim::World>(model, std::move(cp.state), options.threads);
+    setup.earlier_wall_s = cp.run_wall_time_s;
   } catch (const out::CheckpointError& e) {
     log << "error: " << e.what() << "\n";
     return kExitBadInput;

@@ -119,7 +119,7 @@ constexpr const char* kRunChecksum = "run_crc32";
 /// The checkpoint file's bytes, built in memory: HDF5 never meets the disk, so
 /// a full disk is one failed write() with its errno (writeFileAtomically).
 std::string fileImage(const std::string& name, const WorldState& state, const std::string& scene_text,
-                      std::span<const std::uint8_t> experiment_state) {
+                      std::span<const std::uint8_t> experiment_state, double run_wall_time_s) {
   detail::FileHandle handle(name, true);
   const H5::Group& file = handle.root();
   writeTextAttribute(file, "format", kFormat);
@@ -137,6 +137,7 @@ std::string fileImage(const std::string& name, const WorldState& state, const st
   writeBonds(file, state.bonds);
   writeArray(file, "moving_wall_work", std::vector<double>{state.moving_wall_work}, "J");
   if (!experiment_state.empty()) writeArray(file, "experiment", experiment_state, "");
+  if (std::isfinite(run_wall_time_s)) writeArray(file, "run_wall_time_s", std::vector<double>{run_wall_time_s}, "s");
   std::string image = handle.image();
   handle.close();
   return image;
@@ -352,6 +353,13 @@ Checkpoint readFile(const Reader& in) {
       in.fail("dataset /moving_wall_work: " + std::to_string(work[0]) + " J (allowed: a finite number)");
     state.moving_wall_work = work[0];
   }
+  if (in.has("/run_wall_time_s")) {
+    const auto wall = in.array<double>("/run_wall_time_s");
+    if (wall.size() != 1) in.fail("dataset /run_wall_time_s holds " + std::to_string(wall.size()) + " values (expected 1)");
+    if (!(wall[0] >= 0) || !std::isfinite(wall[0]))
+      in.fail("dataset /run_wall_time_s: " + std::to_string(wall[0]) + " s (allowed: a finite number >= 0)");
+    checkpoint.run_wall_time_s = wall[0];
+  }
   if (in.has("/experiment")) checkpoint.experiment_state = in.array<std::uint8_t>("/experiment");
   if (const std::string problem = inconsistency(state); !problem.empty()) in.fail(problem);
   checkpoint.unchecked = in.unchecked();
@@ -361,7 +369,8 @@ Checkpoint readFile(const Reader& in) {
 }  // namespace
 
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
-                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state) {
+                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state,
+                     double run_wall_time_s) {
   detail::recordHdf5Errors();  // errors reach the caller as exceptions, with the system's reason
   const std::string what = "cannot write checkpoint " + quoted(path) + ": ";
   if (const std::string problem = inconsistency(state); !problem.empty()) throw CheckpointError(what + problem);
@@ -370,7 +379,7 @@ void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
 
   std::string image;
   try {
-    image = fileImage(path.string(), state, scene_text, experiment_state);
+    image = fileImage(path.string(), state, scene_text, experiment_state, run_wall_time_s);
   } catch (const H5::Exception& e) {
     throw fail(detail::hdf5Failure(e));
   }

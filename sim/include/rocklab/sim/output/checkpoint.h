@@ -14,6 +14,7 @@
 // dataset carries "unit" and "crc32" (CRC-32 of its bytes) attributes.
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -31,13 +32,18 @@ struct CheckpointError : std::runtime_error {
 /// disk) throws OutputError (file_write.h) naming the file and the system's
 /// reason, removes the temporary and leaves an existing checkpoint as it was; a
 /// state whose arrays disagree throws CheckpointError.
+/// `run_wall_time_s`: the wall time (s) the runs that led to this state took, this one
+/// up to now included (a restart carries it on); NaN when not known (not written).
 void writeCheckpoint(const std::filesystem::path& path, const WorldState& state,
-                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state = {});
+                     const std::string& scene_text, std::span<const std::uint8_t> experiment_state = {},
+                     double run_wall_time_s = std::numeric_limits<double>::quiet_NaN());
 
 struct Checkpoint {
   WorldState state;
   std::string scene_text;
   std::vector<std::uint8_t> experiment_state;  // empty: the run saved none
+  // s, wall time of the runs that led to this state; NaN: not saved (older files)
+  double run_wall_time_s = std::numeric_limits<double>::quiet_NaN();
   // Datasets (and the block of run attributes) read without a checksum: files
   // written before checksums were stored are read, but unchecked.
   std::size_t unchecked = 0;
