@@ -25,6 +25,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 
 # Dry run: refuse if apt would remove anything (the ParaView conflict, or another one).
+$sudo_cmd apt-get update -qq || echo "install-peer: apt-get update failed: trying the package lists as they are" >&2
 plan=$(LC_ALL=C $sudo_cmd apt-get -s install --no-install-recommends "${peer_packages[@]}" 2>&1) || {
   echo "install-peer: apt-get cannot install ${peer_packages[*]}:" >&2; echo "$plan" >&2; exit 2; }
 removals=$(grep '^Remv' <<<"$plan" || true)
