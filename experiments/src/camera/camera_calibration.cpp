@@ -61,6 +61,7 @@ WallCalibration calibrateOnWall(const geometry::Camera& truth, const render::Ren
   // its x axis along the image's right on the wall, y up, z = x × y = the wall normal.
   WallCalibration out;
   render::Checkerboard& board = out.board;
+  if (view_h > view_w) std::swap(board.inner_cols, board.inner_rows);  // the board's long side along the view's
   board.square = 1e-3 * std::floor(1e3 * 0.5 * std::min(view_w / (board.inner_cols + 3), view_h / (board.inner_rows + 3)));
   Mat3 upright;
   upright.col(0) = (truth.rotation.row(0).transpose() - n * n.dot(truth.rotation.row(0).transpose())).normalized();
