@@ -237,6 +237,12 @@ TEST_CASE("samples: sweeps of the same variants on three samples merge into mean
   CHECK(table[1] == "0.1,3,0.72,0.02,0.7,0.74,3,1,3");
   CHECK(table[2] == "0.2,2,0.62,0.0282843,0.6,0.64,2,0,2");
   CHECK(table[3] == "0.3,3,0.53,0.0424264,0.5,0.56,2,0,3");
+  const auto md = lines(merged / "samples.md");  // the same table for a report
+  REQUIRE(md.size() >= 5);
+  CHECK(md[0] == "| contact.damping_normal | samples | restitution | jammed |");
+  CHECK(md[2] == "| 0.1 | 3 | 0.72 ± 0.02 (3) | 1/3 |");
+  CHECK(md[3] == "| 0.2 | 2 | 0.62 ± 0.028 (2) | 0/2 |");
+  CHECK(md[4] == "| 0.3 | 3 | 0.53 ± 0.042 (2) | 0/3 |");
   const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(merged / "samples.json"));
   CHECK(j["samples"][2]["label"] == "third");
   CHECK(j["sets"][2]["runs_not_ok"] == 1);

@@ -224,6 +224,53 @@ Merged merge(const std::vector<SampleSet>& sets, const std::string& over) {
 
 std::string formatted(double v) { return detail::cell(numberJson(v)); }
 
+/// A number to `digits` significant digits (NaN: "-").
+std::string significant(double v, int digits) {
+  if (!std::isfinite(v)) return "-";
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+/// samples.md: the table as a report takes it, a row a variant: a number's mean ± sample
+/// sd (n) to three digits, a true/false figure's count of true out of n, text as it is.
+std::string markdownTable(const Merged& m) {
+  const auto escaped = [](std::string text) {
+    for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) text.insert(at, "\\");
+    return text;
+  };
+  std::ostringstream md;
+  md << '|';
+  for (const std::string& k : m.keys) md << ' ' << escaped(k) << " |";
+  md << " samples |";
+  for (const std::string& f : m.figures) md << ' ' << escaped(f) << " |";
+  md << "\n|";
+  for (std::size_t c = 0; c < m.keys.size() + 1 + m.figures.size(); ++c) md << "---|";
+  md << '\n';
+  for (std::size_t v = 0; v < m.variants.size(); ++v) {
+    md << '|';
+    for (const std::string& value : m.variants[v]) md << ' ' << escaped(value) << " |";
+    md << ' ' << m.rows[v] << " |";
+    for (std::size_t f = 0; f < m.figures.size(); ++f) {
+      const Statistics& st = m.stats[f][v];
+      md << ' ';
+      switch (m.kinds[f]) {
+        case FigureKind::Number:
+          if (st.n == 0) md << "- (0)";
+          else md << significant(st.mean, 3) << (st.n > 1 ? " ± " + significant(st.sd, 2) : "") << " (" << st.n << ')';
+          break;
+        case FigureKind::Flag: md << st.true_count << '/' << st.n; break;
+        case FigureKind::Text: md << escaped(detail::joinedText(st.texts, "; ")); break;
+      }
+      md << " |";
+    }
+    md << '\n';
+  }
+  md << "\nmean ± sample standard deviation (number of samples that have the figure); true/false figures: "
+        "true out of n\n";
+  return md.str();
+}
+
 /// samples.png: the figure against the first varied key whose values are all numbers
 /// (else the variant's row), a group a combination of the other keys; each sample a
 /// point, the mean a line where every sample has the figure.
@@ -360,9 +407,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
           entry["true"] = st.true_count;
           break;
         case FigureKind::Text: {
-          std::string all;
-          for (const std::string& t : st.texts) all += (all.empty() ? "" : "; ") + t;
-          csv << ',' << detail::csvCell(all);
+          csv << ',' << detail::csvCell(detail::joinedText(st.texts, "; "));
           entry["values"] = st.texts;
           break;
         }
@@ -388,6 +433,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
     std::filesystem::create_directories(o.out_dir);
     detail::writeAtomically(o.out_dir / "samples.csv", csv.str());
     detail::writeAtomically(o.out_dir / "samples.json", detail::jsonText(summary));
+    detail::writeAtomically(o.out_dir / "samples.md", markdownTable(m));
     if (figure) writePlot(samplesPlot(m, *figure, m.sample_labels.size()), o.out_dir / "samples.png");
   } catch (const std::exception& e) {
     err << "error: samples: " << e.what() << '\n';
@@ -417,7 +463,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
   }
   for (const SampleSet& s : sets)
     if (s.table.not_ok) out << "note: " << s.label << ": " << s.table.not_ok << " run(s) not ok, left out\n";
-  out << "wrote " << (o.out_dir / "samples.csv").string() << ", samples.json"
+  out << "wrote " << (o.out_dir / "samples.csv").string() << ", samples.json, samples.md"
       << (figure ? ", samples.png" : " (no figure with numbers: no plot)") << '\n';
   return 0;
 }
