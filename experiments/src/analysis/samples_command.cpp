@@ -228,7 +228,8 @@ std::string formatted(double v) { return detail::cell(numberJson(v)); }
 std::string significant(double v, int digits) {
   if (!std::isfinite(v)) return "-";
   std::ostringstream s;
-  s << std::setprecision(digits) << v;
+  if (std::abs(v) >= std::pow(10.0, digits)) s << std::fixed << std::setprecision(0) << v;  // 4366, not 4.37e+03
+  else s << std::setprecision(digits) << v;
   return s.str();
 }
 
