@@ -240,9 +240,9 @@ TEST_CASE("samples: sweeps of the same variants on three samples merge into mean
   const auto md = lines(merged / "samples.md");  // the same table for a report
   REQUIRE(md.size() >= 5);
   CHECK(md[0] == "| contact.damping_normal | samples | restitution | jammed |");
-  CHECK(md[2] == "| 0.1 | 3 | 0.72 ± 0.02 (3) | 1/3 |");
-  CHECK(md[3] == "| 0.2 | 2 | 0.62 ± 0.028 (2) | 0/2 |");
-  CHECK(md[4] == "| 0.3 | 3 | 0.53 ± 0.042 (2) | 0/3 |");
+  CHECK(md[2] == "| 0.1 | 3 | 0.720 ± 0.020 (3) | 1/3 |");
+  CHECK(md[3] == "| 0.2 | 2 | 0.620 ± 0.028 (2) | 0/2 |");
+  CHECK(md[4] == "| 0.3 | 3 | 0.530 ± 0.042 (2) | 0/3 |");
   const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(merged / "samples.json"));
   CHECK(j["samples"][2]["label"] == "third");
   CHECK(j["sets"][2]["runs_not_ok"] == 1);

@@ -228,8 +228,10 @@ std::string formatted(double v) { return detail::cell(numberJson(v)); }
 std::string significant(double v, int digits) {
   if (!std::isfinite(v)) return "-";
   std::ostringstream s;
-  if (std::abs(v) >= std::pow(10.0, digits)) s << std::fixed << std::setprecision(0) << v;  // 4366, not 4.37e+03
-  else s << std::setprecision(digits) << v;
+  // Whole from `digits` digits before the point (4366, not 4.37e+03; 29, not 29.), else with
+  // its trailing zeros (1.00, not 1).
+  if (std::abs(v) >= std::pow(10.0, digits - 1)) s << std::fixed << std::setprecision(0) << v;
+  else s << std::showpoint << std::setprecision(digits) << v;
   return s.str();
 }
 
