@@ -142,7 +142,7 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     nlohmann::json means = nlohmann::json::array();
     for (const auto& [column, v] : run.column_mean)
       means.push_back({{"column", column}, {"distance_m", run.column_distance_m.at(column)},
-                       {"mean_truth_velocity_mps", std::isfinite(v) ? nlohmann::json(v) : nlohmann::json()}});
+                       {"mean_truth_velocity_mps", detail::finiteOrNull(v)}});
     row["columns"] = means;
     table.push_back(row);
   }

@@ -135,7 +135,6 @@ Statistics statisticsOf(FigureKind kind, const std::vector<std::optional<std::st
   return st;
 }
 
-json numberJson(double v) { return std::isfinite(v) ? json(v) : json(); }
 
 /// A cell as samples.json gives it: a number, true/false, text, or null (empty or no run).
 json cellJson(FigureKind kind, const std::optional<std::string>& c) {
@@ -222,7 +221,7 @@ Merged merge(const std::vector<SampleSet>& sets, const std::string& over) {
   return m;
 }
 
-std::string formatted(double v) { return detail::cell(numberJson(v)); }
+std::string formatted(double v) { return detail::cell(detail::finiteOrNull(v)); }
 
 /// A number to `digits` significant digits (NaN: "-").
 std::string significant(double v, int digits) {
@@ -402,8 +401,8 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
         case FigureKind::Number:
           csv << ',' << formatted(st.mean) << ',' << formatted(st.sd) << ',' << formatted(st.min) << ','
               << formatted(st.max) << ',' << st.n;
-          entry.update({{"mean", numberJson(st.mean)}, {"sd", numberJson(st.sd)}, {"min", numberJson(st.min)},
-                        {"max", numberJson(st.max)}});
+          entry.update({{"mean", detail::finiteOrNull(st.mean)}, {"sd", detail::finiteOrNull(st.sd)}, {"min", detail::finiteOrNull(st.min)},
+                        {"max", detail::finiteOrNull(st.max)}});
           break;
         case FigureKind::Flag:
           csv << ',' << st.true_count << ',' << st.n;

@@ -4,12 +4,16 @@
 // go into these files, and a Linux path is bytes, not necessarily UTF-8: bytes that
 // are not UTF-8 are written as U+FFFD instead of making the dump throw (which
 // would lose the whole file). Internal.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
 namespace rocklab::experiments::detail {
+
+/// A number for a JSON file: null where it is not finite (JSON has no NaN or infinity).
+inline nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 inline std::string jsonText(const nlohmann::json& j) {
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";

@@ -31,6 +31,7 @@
 #include "camera/camera_calibration.h"
 #include "camera/camera_recorder.h"
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "drivers/settle.h"
 #include "rocklab/sim/wall_motion.h"
 #include "rocklab/track/export.h"
@@ -59,10 +60,6 @@ struct Marker {
 };
 
 constexpr double kOnset = 0.002;  // m of travel that marks the start of a marker's motion
-
-nlohmann::json orNull(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
 
 // A restart's state (saveState): every member, NaN included (CBOR keeps it).
 std::array<double, 3> asArray(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
@@ -628,7 +625,7 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
     const double v = best >= 0 ? t.velocities[static_cast<std::size_t>(best)].velocity
                                : std::numeric_limits<double>::quiet_NaN();
     if (best >= 0) used[static_cast<std::size_t>(best)] = true;
-    out["tracked_velocity_mps"] = orNull(v);
+    out["tracked_velocity_mps"] = detail::finiteOrNull(v);
     if (std::isfinite(v)) ++tracked;
     for (std::size_t d = 0; best >= 0 && d < t.depth_variants.size() && std::isfinite(m.velocity); ++d) {
       const double other = t.depth_variants[d].second[static_cast<std::size_t>(best)].velocity;
@@ -747,7 +744,7 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
 void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out_dir,
                              std::ostream& log) {
   const bool flowed = std::isfinite(gate_time_);
-  r["clearance_time_s"] = orNull(clearance_time_);
+  r["clearance_time_s"] = detail::finiteOrNull(clearance_time_);
   r["jammed"] = jammed_;
   nlohmann::json markers = nlohmann::json::array();
   for (const Marker& m : markers_)
@@ -756,10 +753,10 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                        {"row", m.row},
                        {"lab_position_m", {m.target.x(), m.target.y(), m.target.z()}},
                        {"start_position_m", {m.start.x(), m.start.y(), m.start.z()}},
-                       {"onset_time_s", orNull(m.onset_time)},
-                       {"travel_time_s", orNull(m.travel_time)},
-                       {"truth_velocity_mps", orNull(m.velocity)},
-                       {"velocity_from_gate_mps", orNull(m.velocity_from_gate)}});
+                       {"onset_time_s", detail::finiteOrNull(m.onset_time)},
+                       {"travel_time_s", detail::finiteOrNull(m.travel_time)},
+                       {"truth_velocity_mps", detail::finiteOrNull(m.velocity)},
+                       {"velocity_from_gate_mps", detail::finiteOrNull(m.velocity_from_gate)}});
   const nlohmann::json tracking = reportTracking(markers, out_dir, log);
   r["markers"] = markers;
   if (!tracking.is_null()) r["tracking"] = tracking;
@@ -800,7 +797,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"gravity_tilt", e_.rotate_gravity ? "rotate" : "add"},
                 {"deposit_inclination_deg", e_.deposit_inclination_deg},
                 {"deposit_settled", settle_.settled()},
-                {"deposit_end_s", orNull(deposit_time_)},
+                {"deposit_end_s", detail::finiteOrNull(deposit_time_)},
                 {"deposit_max_speed_mps", settle_.maxSpeed()},
                 {"settle_scope", e_.top_wall.empty() ? "all" : e_.settle_scope},
                 {"stop_after", e_.stop_after},
@@ -808,7 +805,7 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
                 {"bed_height_m", bed_height_},
                 {"bodies_removed_by_top_plate", removed_by_top_},
                 {"bodies", bodies_total_},
-                {"gate_open_s", orNull(gate_time_)},
+                {"gate_open_s", detail::finiteOrNull(gate_time_)},
                 {"discharged_bodies", discharged_count_},
                 {"discharged_mass_kg", discharged_mass_},
                 {"measure_distance_m", e_.measure_distance},

@@ -22,8 +22,6 @@ namespace {
 
 using json = nlohmann::json;
 
-json finiteOrNull(double v) { return std::isfinite(v) ? json(v) : json(); }
-
 std::string hex(std::uint64_t v) {
   std::ostringstream s;
   s << std::hex << std::setw(16) << std::setfill('0') << v;
@@ -156,8 +154,8 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
                       {"total", total},
                       // A restart's own time is `total`; these count the runs it continues
                       // too (their checkpoints carry it; null from a checkpoint that did not).
-                      {"earlier_runs", finiteOrNull(setup.earlier_wall_s)},
-                      {"all_runs", finiteOrNull(setup.earlier_wall_s + total)}};
+                      {"earlier_runs", detail::finiteOrNull(setup.earlier_wall_s)},
+                      {"all_runs", detail::finiteOrNull(setup.earlier_wall_s + total)}};
   r["stage_seconds"] = stageSecondsJson(record);
   r["particle_steps_per_s"] =  // balls, members included
       stepping > 0 ? static_cast<double>(record.ball_steps) / stepping : 0.0;

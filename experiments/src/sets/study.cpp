@@ -248,13 +248,12 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
     rows.push_back(row);
     json values = json::object();
     for (std::size_t j = 0; j < p.values.size(); ++j) values[o.runs.vary[j].first] = p.values[j];
-    auto num = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
     json entry = {{"values", values},
                   {"folder", "runs/" + runs[rows_in[k].members.front()].name},
-                  {"figure", num(p.figure)},
-                  {"error", num(p.error)},
-                  {"error_pct", num(p.error_pct)},
-                  {"wall_time_s", num(p.wall_s)},
+                  {"figure", detail::finiteOrNull(p.figure)},
+                  {"error", detail::finiteOrNull(p.error)},
+                  {"error_pct", detail::finiteOrNull(p.error_pct)},
+                  {"wall_time_s", detail::finiteOrNull(p.wall_s)},
                   {"pareto", p.pareto},
                   {"reference", p.is_reference},
                   {"status", rows_in[k].status}};
@@ -263,12 +262,12 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
       for (std::size_t m : rows_in[k].members)
         each.push_back({{"seed", done[m].values.back()},
                         {"folder", "runs/" + runs[m].name},
-                        {"figure", num(number(lookup(done[m].results, o.figure)))},
-                        {"wall_time_s", num(number(lookup(done[m].results, "wall_time_s.total")))},
+                        {"figure", detail::finiteOrNull(number(lookup(done[m].results, o.figure)))},
+                        {"wall_time_s", detail::finiteOrNull(number(lookup(done[m].results, "wall_time_s.total")))},
                         {"status", done[m].status}});  // inspectRuns: "ok", "exit N: ...", "missing"
       entry["runs"] = each;
-      entry["scatter"] = num(p.scatter);
-      entry["error_over_scatter"] = num(t);
+      entry["scatter"] = detail::finiteOrNull(p.scatter);
+      entry["error_over_scatter"] = detail::finiteOrNull(t);
     }
     rows_json.push_back(entry);
   }

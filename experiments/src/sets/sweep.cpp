@@ -297,7 +297,7 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
   writeMetricTable(o, metrics, tried, dir / "calibration.csv", log);
   json out = {{"scene", first.run.name}, {"key", key},           {"target_metric", c.target_metric},
               {"target", c.target},      {"method", how},        {"runs", tried.size()},
-              {"estimate", std::isfinite(estimate) ? json(estimate) : json(nullptr)},
+              {"estimate", detail::finiteOrNull(estimate)},
               {"status", std::isfinite(estimate) ? "done" : "no_estimate"}};
   detail::writeAtomically(dir / "calibration.json", detail::jsonText(out));
   refreshSetReport(dir, log, "calibrate");
