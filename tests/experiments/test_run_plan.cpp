@@ -146,6 +146,45 @@ TEST_CASE("a planned set leaves an invalid variant out of its run list, says why
   fs::remove_all(dir);
 }
 
+TEST_CASE("sweep --x-over: one number of a vector varied, plotted over a figure of each run, kept by collect", "[plan]") {
+  // The drop height (the z of the pebble's position) over the contact time: the zoned chute's
+  // CSS (walls.top.corner.2) over the clump's equivalent diameter works the same way.
+  const fs::path dir = fresh("x-over");
+  const std::vector<std::string> sweep = {"sweep", "drop", "--vary", "particles.0.positions.0.2=0.06,0.11", "--metric",
+                                          "restitution", "--x-over", "drop.contact_time_s", "--jobs", "0",
+                                          "--out", dir.string(), "--quiet"};
+  REQUIRE(cli(sweep) == 0);
+  // The divisor is tabulated beside the figures, and the plot's x is the value over it.
+  const auto table = lines(dir / "sweep.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[0] == "particles.0.positions.0.2,restitution,drop.contact_time_s,status");
+  const auto plot = lines(dir / "sweep.plot.csv");
+  REQUIRE(plot.size() == 3);
+  CHECK(plot[0] == "series,particles.0.positions.0.2 / drop.contact_time_s,restitution");
+  auto field = [](const std::string& row, int n) {
+    std::size_t a = 0;
+    for (int c = 0; c < n; ++c) a = row.find(',', a) + 1;
+    return std::stod(row.substr(a, row.find(',', a) - a));
+  };
+  for (int r = 1; r <= 2; ++r) {
+    const double height = field(table[r], 0), contact_time = field(table[r], 2);
+    CHECK(height == (r == 1 ? 0.06 : 0.11));
+    CHECK(contact_time > 0);
+    CHECK(field(plot[r], 1) == Approx(height / contact_time).epsilon(1e-5));  // the table has 6 digits
+  }
+  // collect draws the same plot from plan.json.
+  const auto before = lines(dir / "sweep.plot.csv");
+  fs::remove(dir / "sweep.plot.csv");
+  REQUIRE(cli({"collect", dir.string()}) == 0);
+  CHECK(lines(dir / "sweep.plot.csv") == before);
+  // A key whose values are not numbers cannot be divided: refused before anything runs.
+  const fs::path bad = fresh("x-over-bad");
+  CHECK(cli({"sweep", "drop", "--vary", "particles.0.positions=[[0,0,0.06]],[[0,0,0.11]]", "--x-over",
+             "drop.contact_time_s", "--out", bad.string(), "--quiet"}) == 2);
+  CHECK_FALSE(fs::exists(bad));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("the Slurm array script on a local one-node Slurm gives the table of --jobs 2", "[plan][validation]") {
   // Starts (installing if needed) slurmctld + slurmd + munge on this machine.
   REQUIRE(shell("bash '" ROCKLAB_SOURCE_DIR "/scripts/local-slurm.sh' > /dev/null") == 0);

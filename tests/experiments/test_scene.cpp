@@ -115,6 +115,24 @@ TEST_CASE("option set overrides: values - array indices and bad paths", "[scene]
              Contains("--set scene.end_tim=3: unknown key 'scene.end_tim'"));
 }
 
+TEST_CASE("option set overrides: one number of an array of numbers by its index", "[scene]") {
+  // A sweep varies one component of a vector as a number (the zoned chute's CSS, walls.top.corner.2).
+  const Scene s = loadSceneText(kMinimal + "\n[gravity]\nvector = [0.5, 0, -9.81]\n", "t.toml",
+                                {"gravity.vector.2=-2", "gravity.vector.0=0.25", "particles.0.positions.0.2=0.3"});
+  CHECK(s.model.gravity == Eigen::Vector3d(0.25, 0, -2));
+  CHECK(s.spheres[0].position.z() == 0.3);
+  // The reader still checks the array as a whole, and the message names the --set.
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.positions.0.2=\"x\""}),
+             Contains("--set particles.0.positions.0.2=\"x\": entry 2 of 'particles.0.positions.0' is a number and the "
+                      "value a string"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.positions.0.3=1"}),
+             Contains("'particles.0.positions.0' is an array of 3; '3' must be an index into it (allowed: 0 to 2"));
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.positions.x=1"}), Contains("'x' must be an index into it"));
+  // An array of arrays: its entries are set whole, not by a number.
+  CHECK_THAT(errorOf(kMinimal, {"particles.0.positions.0=1"}),
+             Contains("entry 0 of 'particles.0.positions' is an array and the value an integer"));
+}
+
 TEST_CASE("every built-in scene loads", "[scene]") {
   int count = 0;
   for (const auto& e : std::filesystem::directory_iterator(builtinSceneDir())) {

@@ -169,6 +169,7 @@ struct CliArgs {
   bool quiet = false, skip_complete = false, overwrite = false;
   // sweep, calibrate, study
   std::vector<std::string> vary, metrics;
+  std::string x_over;
   std::string target, plan_dir, figure, reference;
   int iterations = 8, jobs = -1, seeds = 0;
   double tolerance = -1.0;
@@ -322,6 +323,9 @@ void addCommands(CLI::App& app, CliArgs& a) {
   auto* sweep = app.add_subcommand("sweep", "Run a scene for every combination of --vary values; writes sweep.csv and sweep.png");
   addSweepOptions(sweep, a);
   sweep->add_option("--metric", a.metrics, "results.json figure to tabulate, dotted path (default: the experiment's)");
+  sweep->add_option("--x-over", a.x_over,
+                    "Plot against the first --vary key's value divided by this results.json figure of each run "
+                    "(e.g. clump_shapes.0.equivalent_diameter_m: CSS / d_eq); tabulated too");
   addSetOptions(sweep, a);
   auto* calibrate = app.add_subcommand(
       "calibrate", "Find the value of one key that gives a target figure (list: interpolate; lo:hi range: bisect)");
@@ -437,6 +441,7 @@ int sweepCommand(const CliArgs& a, bool calibrate) {
   so.scene = a.scene_arg;
   so.overrides = a.overrides;
   so.metrics = a.metrics;
+  so.x_over = a.x_over;
   so.out_dir = a.out_dir;
   so.threads = a.threads;
   so.progress = !a.quiet;

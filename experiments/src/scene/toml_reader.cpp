@@ -427,6 +427,34 @@ void TableReader::finish() const {
   }
 }
 
+namespace {
+
+/// One number of an array of numbers (`--set walls.top.corner.2=0.04`), so that a
+/// sweep can vary one component of a vector as a number (and plot against it).
+/// Returns `index`, the key's last part.
+std::string setArrayEntry(toml::array& numbers, const std::string& index, const toml::node& value,
+                          const std::string& assignment, const std::string& array_key) {
+  const std::string last = numbers.empty() ? "none" : std::to_string(numbers.size() - 1);
+  if (index.find_first_not_of("0123456789") != std::string::npos || index.size() > 9 ||
+      std::stoul(index) >= numbers.size())
+    throw SceneError("--set " + assignment + ": '" + array_key + "' is an array of " + std::to_string(numbers.size()) +
+                     "; '" + index + "' must be an index into it (allowed: 0 to " + last + ", or the whole array: --set " +
+                     array_key + "=[...])");
+  const std::size_t i = std::stoul(index);
+  if (!numbers.get(i)->is_number() || !value.is_number())
+    throw SceneError("--set " + assignment + ": entry " + index + " of '" + array_key + "' is " +
+                     typeName(*numbers.get(i)) + " and the value " + typeName(value) +
+                     "; only a number of an array of numbers is set by index (allowed: a number, or the whole array: --set " +
+                     array_key + "=[...])");
+  if (const auto* whole = value.as_integer())
+    numbers.replace(numbers.cbegin() + static_cast<std::ptrdiff_t>(i), whole->get());
+  else
+    numbers.replace(numbers.cbegin() + static_cast<std::ptrdiff_t>(i), *value.value<double>());
+  return index;
+}
+
+}  // namespace
+
 std::string applyOverride(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -494,6 +522,9 @@ std::string applyOverride(toml::table& root, const std::string& assignment) {
       throw SceneError("--set " + assignment + ": '" + parts[k] + "' is not a table");
     }
   }
+  if (toml::array* numbers = cur->as_array(); numbers && !numbers->is_array_of_tables())
+    return indexed + setArrayEntry(*numbers, parts.back(), *parsed.get("v"), assignment,
+                                   key.substr(0, key.rfind('.')));
   auto t = cur->as_table();
   if (!t) {
     const std::string parent = key.substr(0, key.rfind('.'));

@@ -119,7 +119,9 @@ class TableReader {
 /// "file:line: " for a node.
 std::string where(const toml::source_region& src);
 /// Sets `key.path=value` in `root`; throws SceneError naming the override.
-/// Returns the dotted key with array indices (walls.gate.x -> walls.2.x).
+/// Returns the dotted key with array indices (walls.gate.x -> walls.2.x). A
+/// last part that is an index into an array of numbers sets that number
+/// (walls.top.corner.2=0.04).
 std::string applyOverride(toml::table& root, const std::string& assignment);
 /// The shortest text that reads back as `v` ("0.3", "-0.004", "1e-06", "inf"):
 /// messages print what the user wrote, not 17 digits.

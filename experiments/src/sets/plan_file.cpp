@@ -118,7 +118,10 @@ PlanFile readPlanFile(const std::filesystem::path& dir) {
     run.invalid = r.has("invalid") ? r.string("invalid", false) : "";
     p.runs.push_back(run);
   }
-  if (p.kind == "sweep") p.metrics = plan.strings("metrics", true);
+  if (p.kind == "sweep") {
+    p.metrics = plan.strings("metrics", true);
+    if (plan.has("x_over")) p.options.x_over = plan.string("x_over", true);
+  }
   else checkStudy(plan, p.raw, p.options, p.runs.size());
   return p;
 }

@@ -136,10 +136,12 @@ int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const s
                 const std::vector<Variant>& done, const std::string& name, std::ostream& log) {
   writeMetricTable(o, metrics, done, dir / "sweep.csv", log);
   writeProductCurves(dir, o, done, name, log);
-  // Plot: the first metric against the first key; one series per value of the second key.
+  // Plot: the first metric against the first key (or its value over o.x_over);
+  // one series per value of the second key.
   PlotSpec spec;
-  spec.title = name + ": " + metrics.front() + " against " + o.vary.front().first;
-  spec.x_label = o.vary.front().first;
+  const std::string x_name = o.x_over.empty() ? o.vary.front().first : o.vary.front().first + " / " + o.x_over;
+  spec.title = name + ": " + metrics.front() + " against " + x_name;
+  spec.x_label = x_name;
   spec.y_label = metrics.front();
   const std::size_t groups = o.vary.size() > 1 ? o.vary[1].second.size() : 1;
   for (std::size_t g = 0; g < groups; ++g) {
@@ -152,6 +154,7 @@ int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const s
       } catch (const std::invalid_argument&) {
         s.x.push_back(static_cast<double>(s.x.size()));  // a non-numeric key is plotted by position
       }
+      if (!o.x_over.empty()) s.x.back() /= number(lookup(p.results, o.x_over));  // a failed run: NaN, no point
       s.y.push_back(number(lookup(p.results, metrics.front())));
     }
     spec.series.push_back(s);
@@ -183,10 +186,22 @@ int runSweep(const SweepOptions& o, std::ostream& log) {
     log << "error: " << runs.front().invalid << "\n";
     return kExitBadInput;
   }
+  if (!o.x_over.empty())
+    for (const std::string& v : o.vary.front().second) try {
+        toDouble(v, "--vary " + o.vary.front().first);
+      } catch (const std::invalid_argument& e) {
+        log << "error: sweep: --x-over " << o.x_over << " divides the first --vary key's values, which must be numbers: "
+            << e.what() << "\n";
+        return kExitBadInput;
+      }
   const Scene first = sceneFor(o, valid->values);
-  const std::vector<std::string> metrics = o.metrics.empty() ? defaultMetrics(first) : o.metrics;
+  std::vector<std::string> metrics = o.metrics.empty() ? defaultMetrics(first) : o.metrics;
+  if (!o.x_over.empty() && std::find(metrics.begin(), metrics.end(), o.x_over) == metrics.end())
+    metrics.push_back(o.x_over);  // the divisor in the table beside the figures
   const std::filesystem::path dir = outDirFor(o, first, "-sweep");
-  writePlanFiles(dir, o, runs, {{"kind", "sweep"}, {"metrics", metrics}});
+  json plan_extra{{"kind", "sweep"}, {"metrics", metrics}};
+  if (!o.x_over.empty()) plan_extra["x_over"] = o.x_over;
+  writePlanFiles(dir, o, runs, plan_extra);
   log << "sweep of " << first.run.name << ": " << runs.size() << " runs into " << dir.string() << "\n";
   if (o.plan_only) return reportPlan(dir, runs, "sweep", log);
   const int code = executeRuns(dir, o, runs, log);

@@ -15,6 +15,9 @@ struct SweepOptions {
   std::vector<std::string> overrides;   // fixed --set assignments
   std::vector<std::pair<std::string, std::vector<std::string>>> vary;  // key -> TOML values
   std::vector<std::string> metrics;     // results.json paths ("wall_time_s.total"); empty = by experiment type
+  // The plot's x: the first key's value divided by this results.json figure of each
+  // run ("" = the value itself), e.g. a CSS over the clump's equivalent diameter.
+  std::string x_over;
   std::filesystem::path out_dir;        // "" = out/<scene name>-sweep
   int threads = 0;                      // threads of an in-process run (0 = all cores)
   bool progress = true;
