@@ -434,20 +434,19 @@ namespace {
 /// Returns `index`, the key's last part.
 std::string setArrayEntry(toml::array& numbers, const std::string& index, const toml::node& value,
                           const std::string& assignment, const std::string& array_key) {
-  const std::string last = numbers.empty() ? "none" : std::to_string(numbers.size() - 1);
+  const std::string whole = "the whole array: --set " + array_key + "=[...]";
   if (index.find_first_not_of("0123456789") != std::string::npos || index.size() > 9 ||
       std::stoul(index) >= numbers.size())
     throw SceneError("--set " + assignment + ": '" + array_key + "' is an array of " + std::to_string(numbers.size()) +
-                     "; '" + index + "' must be an index into it (allowed: 0 to " + last + ", or the whole array: --set " +
-                     array_key + "=[...])");
+                     "; '" + index + "' must be an index into it (allowed: " +
+                     (numbers.empty() ? whole : "0 to " + std::to_string(numbers.size() - 1) + ", or " + whole) + ")");
   const std::size_t i = std::stoul(index);
   if (!numbers.get(i)->is_number() || !value.is_number())
     throw SceneError("--set " + assignment + ": entry " + index + " of '" + array_key + "' is " +
                      typeName(*numbers.get(i)) + " and the value " + typeName(value) +
-                     "; only a number of an array of numbers is set by index (allowed: a number, or the whole array: --set " +
-                     array_key + "=[...])");
-  if (const auto* whole = value.as_integer())
-    numbers.replace(numbers.cbegin() + static_cast<std::ptrdiff_t>(i), whole->get());
+                     "; only a number of an array of numbers is set by index (allowed: a number, or " + whole + ")");
+  if (const auto* integer = value.as_integer())
+    numbers.replace(numbers.cbegin() + static_cast<std::ptrdiff_t>(i), integer->get());
   else
     numbers.replace(numbers.cbegin() + static_cast<std::ptrdiff_t>(i), *value.value<double>());
   return index;

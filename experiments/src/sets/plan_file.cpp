@@ -121,8 +121,9 @@ PlanFile readPlanFile(const std::filesystem::path& dir) {
   if (p.kind == "sweep") {
     p.metrics = plan.strings("metrics", true);
     if (plan.has("x_over")) p.options.x_over = plan.string("x_over", true);
+  } else {
+    checkStudy(plan, p.raw, p.options, p.runs.size());
   }
-  else checkStudy(plan, p.raw, p.options, p.runs.size());
   return p;
 }
 
