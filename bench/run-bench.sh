@@ -3,11 +3,13 @@
 # particle-steps per second for each, their ratio, rocklab's 2-thread speed-up
 # and its memory per particle.
 #
-# Usage: bench/run-bench.sh [settle|dense|clumps|grid|order|render|track|memory|all] [small|full] [OUTDIR]
+# Usage: bench/run-bench.sh [settle|dense|clumps|chute|grid|order|render|track|memory|all] [small|full] [OUTDIR]
 #   scene  settle (contact-sparse), dense (contact-rich), clumps (the chute's four-ball clump
 #          landing in a box, then sheared by a sliding floor; ball-steps/s, i.e. clump members,
 #          and member contacts per clump in both engines as the check), grid (7:1 size ratio:
-#          multi-level against single-level neighbour grid, rocklab only), order (the dense
+#          multi-level against single-level neighbour grid, rocklab only), chute (the clump chute
+#          job, chute-30-clumps deposit to clearance with camera and tracking, against its LIGGGHTS
+#          twin; whole-process wall times; not part of all: about 25 min small, an hour full), order (the dense
 #          lattice in lattice order against the same spheres shuffled in memory, rocklab only), render
 #          (frames/s of the OSMesa renderer for 7,000 spheres at 640x480 and
 #          1280x1024, rocklab only), track (marker detection + linking frames/s on
@@ -38,7 +40,7 @@ out=${3:-$(mktemp -d)}
 mkdir -p "$out"
 echo "logs in $out" >&2
 have_peer=1
-case $which_scenes in all|settle|dense|clumps)  # the scenes with a peer: install it where missing
+case $which_scenes in all|settle|dense|clumps|chute)  # the scenes with a peer: install it where missing
   if [ "${ROCKLAB_BENCH_PEER:-install}" = skip ]; then
     have_peer=0; echo "ROCKLAB_BENCH_PEER=skip: rocklab alone, peer columns empty" >&2
   elif ! { command -v liggghts >/dev/null && command -v mpirun >/dev/null; } && ! "$root/scripts/install-peer.sh"; then
@@ -180,6 +182,44 @@ if [ "$which_scenes" = all ] || [ "$which_scenes" = clumps ]; then
       "$( [ -z "$ratio1" ] || printf %.2f "$ratio1")" "$( [ -z "$ratio2" ] || printf %.2f "$ratio2")" "$touch_r" \
       "$( [ -z "$touch_l" ] || printf %.3g "$touch_l")" "$height_r" "$( [ -z "$height_l" ] || printf %.1f "$height_l")"
   done
+fi
+
+# The clump chute job (issue 22): chute-30-clumps as users run it (its camera and tracking on,
+# rocklab's automatic step), deposit to clearance, against bench/liggghts/chute-clumps.liggghts
+# given the same simulated times at dt = 1e-6 s: rocklab's deposit end, gate opening and last
+# discharge. Wall time of each whole process (start-up and output included), seconds. small:
+# rocklab on 2 threads and LIGGGHTS on 1 process (the issue's comparison); full: both engines on 1
+# and 2. The check: the clumps LIGGGHTS still holds at the end (rocklab's are all out).
+if [ "$which_scenes" = chute ]; then
+  printf '\nchute,clumps,simulated_s,rocklab_1t_s,rocklab_2t_s,liggghts_1p_s,liggghts_2p_s,ratio_2t_vs_1p,ratio_1t_vs_1p,ratio_2t_vs_2p,clearance_s,clumps_left_liggghts\n'
+  seconds() { date +%s.%N; }
+  chute_rocklab() {  # threads -> sets wall (s); the run folder rocklab-chute-T
+    local dir="$out/rocklab-chute-$1" t0; t0=$(seconds)
+    "$rocklab" run "$root/assets/scenes/chute-30-clumps.toml" --out "$dir" --overwrite --threads "$1" --quiet >"$dir.log" 2>&1
+    wall=$(echo "$(seconds) - $t0" | bc -l)
+  }
+  chute_peer() {  # procs -> sets pwall (s) and left (clumps at the end); empty without the peer
+    pwall=""; left=""
+    [ $have_peer = 1 ] || return 0
+    local log="$out/liggghts-chute-$1.log" t0; t0=$(seconds)
+    (cd "$out" && mpirun --allow-run-as-root --oversubscribe -np "$1" liggghts -in "$root/bench/liggghts/chute-clumps.liggghts" \
+      -var N 1680 -var INCL 30 -var DEPOSIT "$deposit" -var TILT "$tilt" -var FLOW "$flow" -log none >"$log" 2>&1)
+    pwall=$(echo "$(seconds) - $t0" | bc -l)
+    left=$(awk 'NF == 5 && $1 ~ /^[0-9]+$/ && $2 ~ /^[0-9.]+$/ { c = $2 } END { print c }' "$log")
+  }
+  r1=""; l2=""
+  chute_rocklab 2; r2=$wall
+  res="$out/rocklab-chute-2/results.json"
+  # The peer's steps at its dt of 1e-6 s for rocklab's phase times.
+  deposit=$(printf '%.0f' "$(echo "$(json "$res" deposit_end_s) * 1000000" | bc -l)")
+  tilt=$(printf '%.0f' "$(echo "($(json "$res" gate_open_s) - $(json "$res" deposit_end_s)) * 1000000" | bc -l)")
+  flow=$(printf '%.0f' "$(echo "($(json "$res" simulated_time_s) - $(json "$res" gate_open_s)) * 1000000" | bc -l)")
+  chute_peer 1; l1=$pwall; left1=$left
+  if [ "$sizes" = full ]; then chute_rocklab 1; r1=$wall; chute_peer 2; l2=$pwall; fi
+  ratio() { [ -z "$1" ] || [ -z "$2" ] || printf %.2f "$(echo "$2 / $1" | bc -l)"; }  # peer time / rocklab time
+  printf 'chute,1680,%s,%s,%.0f,%s,%s,%s,%s,%s,%s,%s\n' "$(json "$res" simulated_time_s)" "$( [ -z "$r1" ] || printf %.0f "$r1")" "$r2" \
+    "$( [ -z "$l1" ] || printf %.0f "$l1")" "$( [ -z "$l2" ] || printf %.0f "$l2")" "$(ratio "$r2" "$l1")" "$(ratio "$r1" "$l1")" \
+    "$(ratio "$r2" "$l2")" "$(json "$res" clearance_time_s)" "$left1"
 fi
 
 # Memory order: the dense lattice (N = 16,000, or 2,000 with small) given as a list of its
