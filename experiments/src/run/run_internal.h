@@ -87,6 +87,7 @@ struct RunRecord {
   std::size_t vtk_frames = 0;
   std::uint64_t first_step = 0;  // step count when this run started (restarts: > 0)
   std::size_t start_balls = 0, start_clumps = 0;  // bodies when this run started (experiments may remove some)
+  int start_team = 0;  // the World's full team when this run started (fewer balls later may mean fewer)
   std::uint64_t ball_steps = 0;  // balls stepped, summed over steps (bodies may be removed)
   // Summed (or the largest) over every World of the run (an experiment builds several).
   double network_ratio = 0.0;

@@ -118,6 +118,7 @@ class RunLoop {
     record_.first_step = world_->stepCount();
     record_.start_balls = world_->particles().size();
     record_.start_clumps = world_->particles().clumps.size();
+    record_.start_team = world_->fullTeam();
     end_step_ = std::max(setup_.total_steps, record_.first_step);
     record_.loop_start = Clock::now();
     try {

@@ -128,7 +128,10 @@ json runJson(const Scene& scene, const RunSetup& setup, const RunRecord& record,
   if (!scene.clump_shapes.empty()) r["clump_shapes"] = clumpShapesJson(scene.clump_shapes);
   r["walls"] = world.model().walls.size();
   r["wall_placement"] = wallPlacement(world.model());  // for `rocklab render` (camera/wall_placement.h)
-  r["threads"] = world.fullTeam();
+  // The team the run stepped with: an experiment that removes bodies (a chute's
+  // discharge) ends with fewer balls and its last World may need fewer threads.
+  r["threads"] = record.start_team > 0 ? record.start_team : world.fullTeam();
+  r["threads_at_end"] = world.fullTeam();
   // Steps the adaptive team ran on one thread because it timed faster (sim/src/team_tuner.h).
   r["team"] = {{"probes", world.stats().team_probes},
                {"switches", world.stats().team_switches},
