@@ -177,6 +177,25 @@ TEST_CASE("sweep --x-over: one number of a vector varied, plotted over a figure 
   fs::remove(dir / "sweep.plot.csv");
   REQUIRE(cli({"collect", dir.string()}) == 0);
   CHECK(lines(dir / "sweep.plot.csv") == before);
+  // samples follows the sets' --x-over: the x is the value over the divisor's mean.
+  const fs::path second = fresh("x-over-2"), merged = fresh("x-over-samples"), plain = fresh("x-over-plain");
+  auto with_out = [&](const fs::path& out, bool x_over) {
+    std::vector<std::string> a = sweep;
+    a[std::find(a.begin(), a.end(), "--out") - a.begin() + 1] = out.string();
+    if (!x_over) a.erase(std::find(a.begin(), a.end(), "--x-over"), std::find(a.begin(), a.end(), "--x-over") + 2);
+    return a;
+  };
+  REQUIRE(cli(with_out(second, true)) == 0);
+  REQUIRE(cli({"samples", dir.string(), second.string(), "--out", merged.string()}) == 0);
+  const auto merged_plot = lines(merged / "samples.plot.csv");
+  REQUIRE(merged_plot.size() >= 3);
+  CHECK(merged_plot[0].find("particles.0.positions.0.2 / drop.contact_time_s") != std::string::npos);
+  CHECK(field(merged_plot[1], 1) == Approx(field(table[1], 0) / field(table[1], 2)).epsilon(1e-5));
+  // Sets plotted against different x are not one figure: refused, naming both.
+  REQUIRE(cli(with_out(plain, false)) == 0);
+  CHECK(cli({"samples", dir.string(), plain.string(), "--out", (merged / "no").string()}) == 2);
+  CHECK_FALSE(fs::exists(merged / "no"));
+  for (const fs::path& d : {second, merged, plain}) fs::remove_all(d);
   // A key whose values are not numbers cannot be divided: refused before anything runs.
   const fs::path bad = fresh("x-over-bad");
   CHECK(cli({"sweep", "drop", "--vary", "particles.0.positions=[[0,0,0.06]],[[0,0,0.11]]", "--x-over",

@@ -36,6 +36,7 @@ struct SampleSet {
   std::string label;
   std::filesystem::path dir;
   std::vector<std::string> keys;  // the plan's order
+  std::string x_over;             // the sweep's --x-over ("" none): its plot's x is the first key over it
   SweepTable table;
 };
 
@@ -52,6 +53,7 @@ SampleSet readSet(const std::filesystem::path& dir) {
     throw SamplesInputError((dir / "plan.json").string() + ": kind \"" + plan.kind +
                             "\" (allowed: \"sweep\"; a study merges its seeds itself, `rocklab study --seeds`)");
   for (const auto& [key, values] : plan.options.vary) set.keys.push_back(key);
+  set.x_over = plan.options.x_over;
   try {
     set.table = readCsvTable(dir / "sweep.csv", " (a finished sweep's folder holds it; `rocklab collect " +
                                                     dir.string() + "` writes it from the runs)");
@@ -90,6 +92,10 @@ void checkSameShape(const std::vector<SampleSet>& sets) {
     if (std::set<std::string>(own.begin(), own.end()) != figures)
       throw SamplesInputError(s.table.file.string() + ": figures " + joined(own) + ", " + first.table.file.string() +
                               " has " + joined(first_figures) + " (allowed: sweeps with the same --metric figures)");
+    if (s.x_over != first.x_over || (!s.x_over.empty() && s.keys.front() != first.keys.front()))
+      throw SamplesInputError((s.dir / "plan.json").string() + ": --x-over \"" + s.x_over + "\" of " + s.keys.front() +
+                              ", " + (first.dir / "plan.json").string() + " \"" + first.x_over + "\" of " +
+                              first.keys.front() + " (allowed: sweeps plotted against the same x)");
   }
 }
 
@@ -148,6 +154,7 @@ json cellJson(FigureKind kind, const std::optional<std::string>& c) {
 /// (then any only later samples ran), each figure's cells a sample.
 struct Merged {
   std::vector<std::string> keys, figures;                                   // keys: the varied ones but `over`
+  std::string x_over;  // the sets' --x-over: the plot's x is the first set key's value over this figure's mean
   std::vector<std::string> sample_labels;                                   // a sample
   std::vector<std::size_t> sample_set;                                      // its set
   std::vector<std::vector<std::string>> variants;                           // values in `keys` order
@@ -162,6 +169,8 @@ Merged merge(const std::vector<SampleSet>& sets, const std::string& over) {
   Merged m;
   for (const std::string& k : sets.front().keys)
     if (k != over) m.keys.push_back(k);
+  // The sweeps' x over a figure needs their first key (not the one merged over).
+  if (sets.front().keys.front() != over) m.x_over = sets.front().x_over;
   m.figures = figureColumns(sets.front());
   // The samples first (the cells are sized by them): the sets in order, each set's values
   // of `over` in the order of its table.
@@ -275,7 +284,8 @@ std::string markdownTable(const Merged& m) {
 
 /// samples.png: the figure against the first varied key whose values are all numbers
 /// (else the variant's row), a group a combination of the other keys; each sample a
-/// point, the mean a line where every sample has the figure.
+/// point, the mean a line where every sample has the figure. Sweeps made with
+/// --x-over plot against their first key's value over that figure's mean in the variant.
 PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
   std::optional<std::size_t> x_key;
   for (std::size_t k = 0; k < m.keys.size() && !x_key; ++k) {
@@ -283,10 +293,14 @@ PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
     for (const auto& values : m.variants) all = all && SweepTable::numberIn(values, k).has_value();
     if (all) x_key = k;
   }
+  std::optional<std::size_t> divisor;  // the --x-over figure
+  if (!m.x_over.empty() && x_key == 0)
+    for (std::size_t f = 0; f < m.figures.size(); ++f)
+      if (m.figures[f] == m.x_over && m.kinds[f] == FigureKind::Number) divisor = f;
   PlotSpec spec;
   spec.title = m.figures[figure] + " over " + std::to_string(samples) +
                " samples: each sample a point, the mean a line where every sample has it";
-  spec.x_label = x_key ? m.keys[*x_key] : "variant (row of samples.csv)";
+  spec.x_label = !x_key ? "variant (row of samples.csv)" : divisor ? m.keys[*x_key] + " / " + m.x_over : m.keys[*x_key];
   spec.y_label = m.figures[figure];
   std::map<std::string, std::vector<std::size_t>> groups;  // by the other keys' values
   std::vector<std::string> group_order;
@@ -302,9 +316,14 @@ PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
     const std::string& name = group_order[g];
     std::vector<std::size_t> members = groups[name];
     const auto xOf = [&](std::size_t v) {
-      return x_key ? *SweepTable::numberIn(m.variants[v], *x_key) : static_cast<double>(v + 1);
+      if (!x_key) return static_cast<double>(v + 1);
+      const double x = *SweepTable::numberIn(m.variants[v], *x_key);
+      return divisor ? x / m.stats[*divisor][v].mean : x;  // no sample has the divisor: NaN, no point
     };
-    std::sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) { return xOf(a) < xOf(b); });
+    std::sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) {
+      const double xa = xOf(a), xb = xOf(b);
+      return std::isnan(xb) ? !std::isnan(xa) : xa < xb;  // a variant without an x last
+    });
     PlotSeries points{name.empty() ? "each sample" : name + ": each sample", {}, {}, PlotSeries::Style::Points};
     PlotSeries mean{name.empty() ? "mean" : name + ": mean", {}, {}, PlotSeries::Style::LinePoints};
     for (std::size_t v : members) {
