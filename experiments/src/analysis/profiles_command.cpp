@@ -135,7 +135,7 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     for (const MarkerPoint& m : run.markers)
       csv << detail::csvCell(run.label) << ',' << detail::csvCell(run.dir.string()) << ',' << m.column << ','
           << detail::cell(distance_m.count(m.column) ? nlohmann::json(distance_m[m.column]) : nlohmann::json())
-          << ',' << m.row << ',' << m.height_mm << ',' << detail::cell(std::isfinite(m.velocity) ? nlohmann::json(m.velocity) : nlohmann::json()) << '\n';
+          << ',' << m.row << ',' << m.height_mm << ',' << detail::cell(detail::finiteOrNull(m.velocity)) << '\n';
     nlohmann::json row = run.figures;
     row["label"] = run.label;
     row["run"] = run.dir.string();

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "common/atomic_file.h"
+#include "common/json_text.h"
 #include "rocklab/sim/particle_stress.h"
 #include "rocklab/sim/timestep.h"
 #include "rocklab/sim/world.h"
@@ -451,7 +452,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
     std::size_t n = 0;
     for (const BreakageEvent& e : events_)
       if (e.diameter * 1e3 >= lo && e.diameter * 1e3 < hi) ++n;
-    by_size.push_back({{"from_mm", lo}, {"to_mm", std::isfinite(hi) ? nlohmann::json(hi) : nlohmann::json(nullptr)},
+    by_size.push_back({{"from_mm", lo}, {"to_mm", detail::finiteOrNull(hi)},
                        {"broken", n}});
   }
   std::ostringstream csv;

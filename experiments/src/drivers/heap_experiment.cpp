@@ -11,6 +11,7 @@
 #include "analysis/plot.h"
 #include "camera/camera_calibration.h"
 #include "camera/camera_recorder.h"
+#include "common/json_text.h"
 #include "drivers/settle.h"
 #include "rocklab/render/image_io.h"
 #include "rocklab/track/plane.h"
@@ -185,7 +186,7 @@ class HeapExperiment final : public Experiment {
     const double mean = 0.5 * (angles[0] + angles[1]);
     out = {{"file", "heap_side.png"},
            {"flank_angles_deg", {angles[0], angles[1]}},
-           {"angle_deg", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
+           {"angle_deg", detail::finiteOrNull(mean)},
            {"height_m", height},
            {"calibration", calibration},
            {"method",

@@ -283,7 +283,7 @@ int reportStudy(const std::filesystem::path& dir, const StudyOptions& o, const s
               {"description", o.description},
               {"figure", o.figure},
               {"reference", {{"kind", o.reference ? "value" : "finest"},
-                             {"value", std::isfinite(a.reference) ? json(a.reference) : json(nullptr)}}},
+                             {"value", detail::finiteOrNull(a.reference)}}},
               {"tolerance_pct", o.tolerance_pct},
               {"seeds", o.seeds},
               {"variants", rows_json},
