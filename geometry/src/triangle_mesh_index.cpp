@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -33,8 +32,6 @@ struct TriangleMeshIndex::Tree {
   TriangleMesh mesh;                 // the triangles' own coordinates (the exact point is computed on them)
   std::vector<Triangle> triangles;   // CGAL's copy, in mesh order (the tree refers to it)
   CgalTree tree;
-  std::vector<std::vector<std::size_t>> vertex_triangles;                          // triangles around a vertex
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> edge_triangles;  // (lo, hi) -> triangles
 
   Vec3 closestOn(std::size_t t, const Vec3& p) const {
     const auto& f = mesh.triangles[t];
@@ -44,10 +41,13 @@ struct TriangleMeshIndex::Tree {
 
 namespace {
 
-std::pair<std::uint32_t, std::uint32_t> edgeKey(std::uint32_t a, std::uint32_t b) { return {std::min(a, b), std::max(a, b)}; }
-
-/// The vertices of triangle f on which q lies: 1 (a vertex), 2 (an edge) or 0 (inside the face).
-std::vector<std::uint32_t> featureOf(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f, const Vec3& q) {
+/// The vertices of triangle f on which q lies: one (a vertex), two (an edge) or
+/// none (inside the face).
+struct Feature {
+  std::array<std::uint32_t, 3> vertex{};
+  int count = 0;
+};
+Feature featureOf(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f, const Vec3& q) {
   const Vec3 a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], c = mesh.vertices[f[2]];
   const Vec3 n = (b - a).cross(c - a);
   const double area2 = n.squaredNorm();
@@ -55,10 +55,11 @@ std::vector<std::uint32_t> featureOf(const TriangleMesh& mesh, const std::array<
   const double w[3] = {(c - b).cross(q - b).dot(n) / area2, (a - c).cross(q - c).dot(n) / area2,
                        (b - a).cross(q - a).dot(n) / area2};
   constexpr double kOnEdge = 1e-9;
-  std::vector<std::uint32_t> on;
+  Feature on;
   for (int k = 0; k < 3; ++k)
-    if (w[k] > kOnEdge) on.push_back(f[k]);
-  return on.size() == 3 ? std::vector<std::uint32_t>{} : on;
+    if (w[k] > kOnEdge) on.vertex[on.count++] = f[k];
+  if (on.count == 3) on.count = 0;
+  return on;
 }
 
 }  // namespace
@@ -69,14 +70,6 @@ TriangleMeshIndex::TriangleMeshIndex(const TriangleMesh& mesh) {
   t->triangles.reserve(mesh.triangles.size());
   for (const auto& f : mesh.triangles)
     t->triangles.emplace_back(point(mesh.vertices[f[0]]), point(mesh.vertices[f[1]]), point(mesh.vertices[f[2]]));
-  t->vertex_triangles.resize(mesh.vertices.size());
-  for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
-    const auto& f = mesh.triangles[k];
-    for (int e = 0; e < 3; ++e) {
-      t->vertex_triangles[f[e]].push_back(k);
-      t->edge_triangles[edgeKey(f[e], f[(e + 1) % 3])].push_back(k);
-    }
-  }
   t->tree.insert(t->triangles.begin(), t->triangles.end());
   t->tree.build();
   t->tree.accelerate_distance_queries();
@@ -174,44 +167,88 @@ bool TriangleMeshIndex::closestPointAmong(const Vec3& p, double radius, std::spa
   return found;
 }
 
-std::vector<TriangleMeshIndex::Touch> TriangleMeshIndex::touches(const Vec3& p, double r) const {
-  const Tree& t = *tree_;
-  std::vector<std::size_t> near;
-  forTrianglesNear(t.tree, t.triangles, p, r, [&](std::size_t k) { near.push_back(k); });
-  std::sort(near.begin(), near.end());
+namespace {
 
-  std::vector<Touch> candidates;
-  for (const std::size_t k : near) {
-    const Vec3 q = t.closestOn(k, p);
-    const double d = (q - p).norm();
-    if (d < r) candidates.push_back({q, k, d});
-  }
-  // An edge or vertex touch is the same contact as a neighbour's when a triangle
-  // sharing that feature comes closer (relative tolerance: ties are kept and merged).
-  auto closerNeighbour = [&](const Touch& c, const std::vector<std::size_t>& around) {
-    for (const std::size_t k : around)
-      if (k != c.triangle && (t.closestOn(k, p) - p).norm() < c.distance * (1 - 1e-12) - 1e-300) return true;
-    return false;
+/// The touches among `candidates` (every triangle nearer to p than r, each with
+/// its closest point and distance, in any order), once each: the rule of
+/// TriangleMeshIndex::touches. An edge or vertex touch is the same contact as a
+/// neighbour's when a triangle sharing that feature comes closer; such a
+/// triangle is nearer than r too, so it is among the candidates.
+void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, double r,
+                 std::vector<TriangleMeshIndex::Touch>& out) {
+  using Touch = TriangleMeshIndex::Touch;
+  out.clear();
+  auto byDistance = [](const Touch& a, const Touch& b) {
+    return a.distance2 != b.distance2 ? a.distance2 < b.distance2 : a.triangle < b.triangle;
   };
-  std::vector<Touch> kept;
-  for (const Touch& c : candidates) {
-    const std::vector<std::uint32_t> on = featureOf(t.mesh, t.mesh.triangles[c.triangle], c.point);
-    if (on.size() == 1 && closerNeighbour(c, t.vertex_triangles[on[0]])) continue;
-    if (on.size() == 2 && closerNeighbour(c, t.edge_triangles.at(edgeKey(on[0], on[1])))) continue;
-    kept.push_back(c);
+  if (candidates.size() == 1) {  // the common case: one triangle in reach
+    out.push_back(candidates[0]);
+    return;
   }
-  std::sort(kept.begin(), kept.end(), [](const Touch& a, const Touch& b) {
-    return a.distance != b.distance ? a.distance < b.distance : a.triangle < b.triangle;
-  });
-  // The same point reached from several triangles (a ridge, an apex): one touch.
-  std::vector<Touch> merged;
-  for (const Touch& c : kept) {
-    const bool seen = std::any_of(merged.begin(), merged.end(), [&](const Touch& m) {
+  std::sort(candidates.begin(), candidates.end(), byDistance);
+  auto holds = [&](std::size_t triangle, std::uint32_t vertex) {
+    const auto& f = mesh.triangles[triangle];
+    return f[0] == vertex || f[1] == vertex || f[2] == vertex;
+  };
+  for (const Touch& c : candidates) {
+    const Feature on = featureOf(mesh, mesh.triangles[c.triangle], c.point);
+    bool shadowed = false;
+    if (on.count > 0) {
+      // Relative tolerance: ties are kept here and merged below.
+      for (const Touch& o : candidates) {
+        if (o.distance >= c.distance * (1 - 1e-12) - 1e-300) break;  // sorted: no nearer one follows
+        if (o.triangle == c.triangle) continue;
+        if (std::all_of(on.vertex.begin(), on.vertex.begin() + on.count,
+                        [&](std::uint32_t v) { return holds(o.triangle, v); })) {
+          shadowed = true;
+          break;
+        }
+      }
+    }
+    if (shadowed) continue;
+    // The same point reached from several triangles (a ridge, an apex): one touch.
+    const bool seen = std::any_of(out.begin(), out.end(), [&](const Touch& m) {
       return (m.point - c.point).norm() <= 1e-12 * std::max(1.0, c.distance + r);
     });
-    if (!seen) merged.push_back(c);
+    if (!seen) out.push_back(c);
   }
-  return merged;
+}
+
+}  // namespace
+
+std::vector<TriangleMeshIndex::Touch> TriangleMeshIndex::touches(const Vec3& p, double r) const {
+  const Tree& t = *tree_;
+  std::vector<Touch> candidates;
+  forTrianglesNear(t.tree, t.triangles, p, r, [&](std::size_t k) {
+    const Vec3 q = t.closestOn(k, p);
+    const double d2 = (q - p).squaredNorm();
+    if (d2 < r * r) candidates.push_back({q, k, std::sqrt(d2), d2});
+  });
+  std::vector<Touch> kept;
+  keepTouches(t.mesh, candidates, r, kept);
+  return kept;
+}
+
+void TriangleMeshIndex::touchesAmong(const Vec3& p, double r, std::span<const std::uint32_t> triangles,
+                                     std::vector<Touch>& out, const CandidateDistances& bounds) const {
+  const Tree& t = *tree_;
+  thread_local std::vector<Touch> candidates;
+  candidates.clear();
+  const bool bounded = bounds.then.size() == triangles.size();
+  const double r2 = r * r;
+  for (std::size_t c = 0; c < triangles.size(); ++c) {
+    if (bounded) {
+      // Nearest first: once a triangle cannot come nearer than r, neither can the
+      // rest (closestPointAmong's bound, with its margin for round-off).
+      const double lower = bounds.then[c] * (1 - 1e-9) - bounds.moved - 1e-12;
+      if (lower > 0 && lower * lower >= r2) break;
+    }
+    const std::uint32_t k = triangles[c];
+    const Vec3 q = t.closestOn(k, p);
+    const double d2 = (q - p).squaredNorm();
+    if (d2 < r2) candidates.push_back({q, k, std::sqrt(d2), d2});
+  }
+  keepTouches(t.mesh, candidates, r, out);
 }
 
 }  // namespace rocklab::geometry

@@ -78,18 +78,15 @@ void World::Impl::forEachElasticContact(PairVisit&& pair, WallVisit&& wall, bool
       pair(i, j, touch.point, Vec3(history.pair_shear[k] - secant * overlap * touch.normal), overlap,
            history.pair_shear[k]);
     }
-    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
-      if (!by_geometry && !history.wall_touch[c]) continue;
-      const std::uint32_t wk = nb.wall_index[c];
-      ContactPoint touch;
-      if (!ballWallTouch(walls_now[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch)) continue;
-      const double overlap = wallOverlap(touch, c);
-      if (overlap <= 0) continue;
+    forEachWallTouch(walls_now, i, [&](std::uint32_t c, std::uint32_t wk, const ContactPoint* touch) {
+      if ((!by_geometry && !history.wall_touch[c]) || !touch) return;
+      const double overlap = wallOverlap(*touch, c);
+      if (overlap <= 0) return;
       double secant, tangent;
       Law::normal(wallProps(i, wk), overlap, p.radius[i], secant, tangent);
-      wall(i, wk, touch.point, Vec3(history.wall_shear[c] - secant * overlap * touch.normal), overlap,
+      wall(i, wk, touch->point, Vec3(history.wall_shear[c] - secant * overlap * touch->normal), overlap,
            history.wall_shear[c]);
-    }
+    });
   }
 }
 

@@ -203,6 +203,17 @@ void checkContacts(Check& c, const Model& model, const WorldState& s) {
   c.indexRows("walls/particle", particle, n, 0, balls);
   c.indexRows("walls/wall", wall, model.walls.size(), 0, "the scene has " + std::to_string(model.walls.size()) + " walls");
   checkHistory(c, "walls", s.wall_history);
+  std::vector<Vec3> normal;
+  for (std::size_t k = 0; c.ok() && k < s.wall_history.size(); ++k) {
+    const WallHistory& h = s.wall_history[k];
+    normal.push_back(h.normal);
+    const bool mesh = model.walls[h.wall].shape == WallShape::Mesh;
+    if (h.slot >= (mesh ? kMeshWallSlots : 1))
+      c.fail("walls/slot row " + std::to_string(k) + ": " + show(h.slot) + " (allowed: " +
+             (mesh ? "0 to " + std::to_string(kMeshWallSlots - 1) + " for the mesh wall '"
+                   : "0 for the wall '") + model.walls[h.wall].name + "')");
+  }
+  if (c.ok()) c.finiteRows("walls/normal", normal);
 }
 
 void checkBonds(Check& c, const WorldState& s) {

@@ -78,7 +78,10 @@ WorldState withoutBalls(WorldState state, std::vector<bool> remove) {
   state.pair_history = std::move(pairs);
   std::vector<WallHistory> walls;
   for (const WallHistory& h : state.wall_history)
-    if (keep[h.particle]) walls.push_back({new_index[h.particle], h.wall, h.shear, h.relax_offset});
+    if (keep[h.particle]) {
+      walls.push_back(h);
+      walls.back().particle = new_index[h.particle];
+    }
   state.wall_history = std::move(walls);
   BondState& bonds = state.bonds;
   std::vector<bool> keep_bond(bonds.size());

@@ -7,6 +7,7 @@
 // skip both maps; a wall that only spins (model.h WallMotion) has a velocity but
 // no pose change.
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
 #include <numbers>
 #include <span>
@@ -115,6 +116,27 @@ class WallRuntime {
     out.normal = toWorldDirection(n);
     out.overlap = r - d;
     return true;
+  }
+
+  /// A mesh wall's touches of a ball (centre x, radius r), nearest first, at most
+  /// out.size() of them (TriangleMeshIndex::touchesAmong over the ball's candidate
+  /// `triangles`, with contact()'s bounds); returns how many. The nearest is
+  /// contact()'s contact, bit for bit.
+  std::size_t meshTouches(const Vec3& x, double r, std::span<const std::uint32_t> triangles,
+                          std::span<WallContact> out, std::span<const double> distances = {},
+                          double ball_moved = 0) const {
+    thread_local std::vector<geometry::TriangleMeshIndex::Touch> found;
+    const Vec3 xb = toBody(x);
+    mesh_index_.touchesAmong(xb, r, triangles, found, {distances, ball_moved + displacementSinceReference()});
+    const std::size_t n = std::min(found.size(), out.size());
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec3 diff = xb - found[k].point;
+      const double d = found[k].distance;
+      // A centre exactly on the surface has no direction: use the face normal.
+      const Vec3 normal = d > 0 ? Vec3(-diff / d) : Vec3(-unit_normal_);
+      out[k] = {toWorldDirection(normal), r - d};
+    }
+    return n;
   }
 
   /// Velocity of the wall material at world point x.

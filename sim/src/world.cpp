@@ -156,10 +156,12 @@ WorldState World::exportState() const {
   for (const PairHistory& h : w.bonds.handover)
     if (!h.shear.isZero(0)) s.pair_history.push_back(h);
   for (std::size_t i = 0; i + 1 < w.nb.wall_offset.size(); ++i)
-    for (std::uint32_t c = w.nb.wall_offset[i]; c < w.nb.wall_offset[i + 1]; ++c)
-      if (!w.history.wall_shear[c].isZero(0) || (w.relax.active() && w.relax.wall[c] > 0))
+    for (std::uint32_t c = w.nb.wall_offset[i]; c < w.nb.wall_offset[i + 1]; ++c) {
+      const Vec3 normal = w.history.wall_normal.empty() ? Vec3::Zero() : w.history.wall_normal[c];
+      if (!w.history.wall_shear[c].isZero(0) || (w.relax.active() && w.relax.wall[c] > 0) || !normal.isZero(0))
         s.wall_history.push_back({static_cast<std::uint32_t>(i), w.nb.wall_index[c], w.history.wall_shear[c],
-                                  w.relax.active() ? w.relax.wall[c] : 0.0});
+                                  w.relax.active() ? w.relax.wall[c] : 0.0, w.nb.wall_slot[c], normal});
+    }
   return s;
 }
 

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -110,6 +111,20 @@ struct ContactPoint {
   return true;
 }
 
+/// A touch continues a slot's contact of the last step when their normals are
+/// within 20 degrees (a step turns a normal by far less; the faces of a crease
+/// may meet at a few degrees, which the nearest-normal rule tells apart).
+inline constexpr double kSameContactCos = 0.9396926207859084;
+
+/// The contacts of a ball with one wall, one per candidate of that wall: a plane
+/// or polygon has one candidate; a mesh wall kMeshWallSlots (slot 0 first).
+struct WallTouches {
+  std::array<ContactPoint, kMeshWallSlots> touch;
+  std::array<bool, kMeshWallSlots> has{};    // the slot's candidate touches now
+  std::array<bool, kMeshWallSlots> fresh{};  // a new contact in a slot that held another one
+  std::uint32_t slots = 1;
+};
+
 /// Where a bond between ball a (xa, ra) and ball b acts: the middle of the gap
 /// (or overlap) between their surfaces along n (unit, a -> b) at centre distance `dist`.
 inline Vec3 bondPoint(const Vec3& xa, double ra, double rb, const Vec3& n, double dist) {
@@ -145,6 +160,7 @@ struct World::Impl {
   TimestepAudit audit;
   WorldStats stats;
   bool has_clumps = false;
+  bool has_mesh_walls = false;  // their contacts take slots (history.wall_normal)
   bool isMember(std::size_t i) const { return has_clumps && p.clump[i] >= 0; }
   // Material-pair constants: ball_ball[a * nm + b], ball_wall[ball * nm + wall].
   std::vector<detail::PairProps> ball_ball, ball_wall;
@@ -180,8 +196,10 @@ struct World::Impl {
     detail::PairList pairs;                  // ball–ball pairs, canonical CSR
     std::vector<std::uint32_t> wall_offset;  // [n+1] ball–wall candidates in rows by ball
     std::vector<std::uint32_t> wall_index;   // [k] wall of each candidate
+    std::vector<std::uint8_t> wall_slot;     // [k] contact slot (mesh walls: 0 .. kMeshWallSlots-1; else 0)
     // Mesh walls: candidate k's triangles within r + skin at the build are
-    // wall_triangles[wall_triangle_offset[k] .. [k+1]] (empty for other walls).
+    // wall_triangles[wall_triangle_offset[k] .. [k+1]] (slot 0 of a mesh wall;
+    // empty for its other slots and for other walls).
     std::vector<std::uint32_t> wall_triangle_offset;  // [k+1]
     std::vector<std::uint32_t> wall_triangles;  // nearest first
     std::vector<double> wall_triangle_distance;  // m, from the ball at the build
@@ -205,6 +223,9 @@ struct World::Impl {
     std::vector<std::uint8_t> pair_touch;    // [pairs] 1 when touching at this step
     std::vector<Vec3> wall_shear;            // [k] N, on the ball
     std::vector<std::uint8_t> wall_touch;    // [k]
+    // [k] unit, a mesh slot's contact normal at the last force pass (zero when
+    // free): which touch continues which contact. Empty without mesh walls.
+    std::vector<Vec3> wall_normal;
   } history;
 
   // --- force scratch (stages 3-5 write, 6 and 8 read)
@@ -314,6 +335,33 @@ struct World::Impl {
   }
   double wallOverlap(const ContactPoint& g, std::uint32_t c) const {
     return relax.active() ? g.overlap - relax.factor * relax.wall[c] : g.overlap;
+  }
+  /// The contacts of ball i with the wall of candidate c (the first of its
+  /// slots), with the walls' poses of `runtime`. A mesh wall's touches go into
+  /// the slots whose last normal (history.wall_normal) is nearest to theirs, when
+  /// within kSameContactCos, and the rest into free slots, lowest first: a
+  /// contact keeps its shear spring while the ball moves along a crease.
+  /// `bounded`: skip the triangles that cannot be touched, from the ball's
+  /// distance moved since the build (the force pass; positions of the build).
+  [[gnu::always_inline]] void wallTouches(const std::vector<detail::WallRuntime>& runtime, std::size_t i,
+                                          std::uint32_t c, WallTouches& out, bool bounded = false) const {
+    const std::uint32_t wk = nb.wall_index[c];
+    if (model.walls[wk].shape == WallShape::Mesh) return meshWallTouches(runtime[wk], i, c, out, bounded);
+    out.slots = 1;
+    out.fresh[0] = false;
+    out.has[0] = ballWallTouch(runtime[wk], model.walls[wk], p.position[i], p.radius[i], {}, out.touch[0]);
+  }
+  void meshWallTouches(const detail::WallRuntime& runtime, std::size_t i, std::uint32_t c, WallTouches& out,
+                       bool bounded) const;
+  /// Calls visit(c, wall, touch or nullptr) for every wall candidate of ball i.
+  template <class Visit>
+  void forEachWallTouch(const std::vector<detail::WallRuntime>& runtime, std::size_t i, Visit&& visit,
+                        bool bounded = false) const {
+    WallTouches t;
+    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; c += t.slots) {
+      wallTouches(runtime, i, c, t, bounded);
+      for (std::uint32_t s = 0; s < t.slots; ++s) visit(c + s, nb.wall_index[c], t.has[s] ? &t.touch[s] : nullptr);
+    }
   }
   double& stageSeconds(Stage s) { return stats.stage_seconds[static_cast<std::size_t>(s)]; }
 

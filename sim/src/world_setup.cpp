@@ -274,8 +274,9 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
     if (!w.walls[h.wall].active) continue;  // the wall was removed: its contacts went with it
     bool found = false;
     for (std::uint32_t c = w.nb.wall_offset[h.particle]; c < w.nb.wall_offset[h.particle + 1]; ++c)
-      if (w.nb.wall_index[c] == h.wall) {
+      if (w.nb.wall_index[c] == h.wall && w.nb.wall_slot[c] == h.slot) {
         w.history.wall_shear[c] = h.shear;
+        if (!w.history.wall_normal.empty()) w.history.wall_normal[c] = h.normal;
         if (h.relax_offset > 0) {
           if (!w.relax.active()) w.relax.start(w.nb.pairs.size(), w.nb.wall_index.size());
           w.relax.wall[c] = h.relax_offset;
@@ -284,8 +285,9 @@ World::World(Model model, WorldState state, int threads) : impl_(std::make_uniqu
       }
     if (!found)
       throw std::invalid_argument("walls row " + std::to_string(row) + ": ball " + std::to_string(h.particle) +
-                                  " and wall '" + w.model.walls[h.wall].name +
-                                  "' (allowed: a ball within contact range of the wall, as saved)");
+                                  " and wall '" + w.model.walls[h.wall].name + "'" +
+                                  (h.slot > 0 ? " (contact slot " + std::to_string(h.slot) + ")" : "") +
+                                  " (allowed: a ball within contact range of the wall, as saved)");
   }
 }
 
@@ -295,6 +297,8 @@ void World::Impl::initialise(int requested_threads) {
   threads = requested_threads > 0 ? requested_threads : omp_get_max_threads();
   guard.check_travel = dt > audit.automatic;  // forced (timestep.allow_unsafe); dt is set by now
   has_clumps = p.clumps.size() > 0;
+  has_mesh_walls = std::any_of(model.walls.begin(), model.walls.end(),
+                               [](const Wall& w) { return w.shape == WallShape::Mesh; });
   buildPairProps();
   walls.resize(model.walls.size());
   for (std::size_t k = 0; k < walls.size(); ++k) walls[k].setup(model.walls[k]);

@@ -20,7 +20,7 @@ TEST_CASE("mesh validation names the problem", "[geometry]") {
   CHECK(mesh.validate().find("refers to vertex 5") != std::string::npos);
 }
 
-TEST_CASE("closest points through the AABB tree equal the brute force", "[geometry]") {
+TEST_CASE("closest points through the AABB tree equal the brute force - and touches over a ball's candidates equal a search of the whole mesh", "[geometry]") {
   // The crusher's concave (a frustum seen from inside: every query point near
   // its concave side) and a 5120-triangle pebble, from points all around,
   // inside, on and far from the surface.
@@ -36,6 +36,7 @@ TEST_CASE("closest points through the AABB tree equal the brute force", "[geomet
     const Vec3 size = box.hi - box.lo;
     Rng rng(11);
     double worst = 0;
+    std::size_t touches_seen = 0, more_than_one = 0;
     for (int k = 0; k < 3000; ++k) {
       const Vec3 u(rng.uniform(), rng.uniform(), rng.uniform());
       Vec3 p = box.lo - 0.2 * size + 1.4 * size.cwiseProduct(u);
@@ -74,7 +75,26 @@ TEST_CASE("closest points through the AABB tree equal the brute force", "[geomet
       Vec3 any_order = Vec3::Zero();
       CHECK(index.closestPointAmong(p, radius, reversed, any_order) == within);
       if (within) CHECK(any_order == near);
+      // The touches over the candidates, bounded or not, are touches() over the
+      // whole mesh, and the nearest is closestPointAmong's point bit for bit.
+      const auto all = index.touches(p, radius);
+      std::vector<TriangleMeshIndex::Touch> listed, skipping;
+      index.touchesAmong(p, radius, candidates, listed);
+      index.touchesAmong(p, radius, candidates, skipping, {distances, (p - before).norm()});
+      REQUIRE(listed.size() == all.size());
+      REQUIRE(skipping.size() == all.size());
+      CHECK(all.empty() != within);
+      for (std::size_t t = 0; t < all.size(); ++t) {
+        CHECK(listed[t].point == all[t].point);
+        CHECK(skipping[t].point == all[t].point);
+        CHECK(listed[t].triangle == all[t].triangle);
+      }
+      if (within) CHECK(listed[0].point == near);
+      touches_seen += all.size();
+      more_than_one += all.size() > 1 ? 1 : 0;
     }
+    INFO("touches " << touches_seen << ", points with more than one " << more_than_one);
+    CHECK(touches_seen > 100);
     INFO("triangles " << mesh.triangleCount());
     CHECK(worst < 1e-12);
   }

@@ -114,6 +114,8 @@ TEST_CASE("restart: every bad value of a saved state is refused with its dataset
       {"NaN shear", [nan](auto& s) { s.pair_history[0].shear.z() = nan; }, "pairs/shear row 0"},
       {"missing wall", [](auto& s) { s.wall_history[0].wall = 7; }, "walls/wall row 0: 7 (allowed: 0 to 0, the scene has 1 walls)"},
       {"wall contact of a missing ball", [](auto& s) { s.wall_history[0].particle = 9; }, "walls/particle row 0: 9"},
+      {"second contact slot on a plane", [](auto& s) { s.wall_history[0].slot = 1; }, "walls/slot row 0: 1 (allowed: 0 for the wall '"},
+      {"NaN contact normal", [nan](auto& s) { s.wall_history[0].normal.x() = nan; }, "walls/normal row 0"},
       {"bond end past the balls", [](auto& s) { s.bonds.b[0] = 1000; }, "bonds/b row 0: 1000"},
       {"bond kind 7", [](auto& s) { s.bonds.kind[0] = 7; }, "bonds/kind row 0: 7 (allowed: 0 parallel, 1 contact)"},
       {"bond intact 2", [](auto& s) { s.bonds.intact[0] = 2; }, "bonds/intact row 0: 2"},

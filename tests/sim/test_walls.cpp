@@ -1,9 +1,12 @@
 // Walls: a mesh plane must act exactly like the analytic plane (also on edges
 // and vertices); polygons, moving walls, removal.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "rocklab/geometry/frustum_mesh.h"
+#include "rocklab/sim/output/checkpoint.h"
 #include "support.h"
 #include "wall_runtime.h"
 
@@ -49,6 +52,90 @@ TEST_CASE("mesh floor = analytic floor - on a face - an edge and a vertex", "[wa
     CHECK((xp - xm).norm() < 1e-12);
     CHECK((vp - vm).norm() < 1e-10);
   }
+}
+
+namespace {
+/// A 90-degree groove along y (faces z = -x and z = x, two triangles each) as
+/// one mesh wall, and the same two faces as plane walls.
+sim::Wall grooveMesh() {
+  sim::Wall w = test::floorPlane();
+  w.name = "groove";
+  w.shape = sim::WallShape::Mesh;
+  w.mesh.vertices = {{-0.1, -0.2, 0.1}, {-0.1, 0.2, 0.1}, {0, -0.2, 0}, {0, 0.2, 0}, {0.1, -0.2, 0.1}, {0.1, 0.2, 0.1}};
+  w.mesh.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
+  return w;
+}
+std::vector<sim::Wall> groovePlanes() {
+  return {test::plane("left", Vec3::Zero(), Vec3(1, 0, 1)), test::plane("right", Vec3::Zero(), Vec3(-1, 0, 1))};
+}
+/// A ball dropped off-centre into the groove with spin and a speed along it:
+/// it rocks from face to face, slides and rolls along the crease, and settles.
+sim::Model grooveModel(const std::vector<sim::Wall>& walls) {
+  // Soft (1e5 N/m): the resting overlaps are about a micrometre, not a few
+  // nanometres, so round-off does not decide whether a face is touched.
+  auto model = test::linearModel(1e5, 0.4, 0.2);
+  model.gravity = Vec3(0, 0, -9.81);
+  model.walls = walls;
+  return model;
+}
+sim::SphereSpec grooveBall() {
+  auto s = test::sphere(Vec3(0.004, -0.05, 0.02), 0.01, {-0.2, 0.3, -0.5});
+  s.omega = Vec3(4, -3, 2);
+  return s;
+}
+}  // namespace
+
+TEST_CASE("a ball in a mesh's concave crease touches both faces: as in the groove of two planes", "[walls]") {
+  // One contact per ball and mesh (the nearest face) would let the ball sink into
+  // the other face; each touch is its own contact with its own shear spring.
+  const double r = 0.01;
+  sim::World planes(grooveModel(groovePlanes()), {grooveBall()}, 1);
+  sim::World mesh(grooveModel({grooveMesh()}), {grooveBall()}, 1);
+  int both = 0, differ = 0;
+  std::size_t on_planes = 0, on_mesh = 0;
+  while (planes.time() < 0.5) {
+    planes.step([&](const sim::Snapshot& s) { on_planes = s.wall_contacts; });
+    mesh.step([&](const sim::Snapshot& s) { on_mesh = s.wall_contacts; });
+    if (on_planes == 2) ++both;
+    if (on_mesh != on_planes) ++differ;  // a touch of a few nm, round-off apart
+  }
+  INFO("dt " << planes.dt() << " s, steps " << planes.stepCount() << ", on both faces " << both);
+  CHECK(both > static_cast<int>(planes.stepCount() / 4));  // it rested on both faces for a while
+  CHECK(differ < static_cast<int>(planes.stepCount() / 1000));
+  const auto& xp = planes.particles().position[0];
+  const auto& xm = mesh.particles().position[0];
+  INFO("planes " << xp.transpose() << "  mesh " << xm.transpose());
+  CHECK((xp - xm).norm() < 1e-9);
+  CHECK((planes.particles().velocity[0] - mesh.particles().velocity[0]).norm() < 1e-8);
+  CHECK((planes.particles().omega[0] - mesh.particles().omega[0]).norm() < 1e-6);
+  // Settled in the crease at the height of two contacts each carrying m g / sqrt(2).
+  CHECK(std::abs(xm.x()) < 1e-6);
+  CHECK(xm.z() < r * std::sqrt(2.0));
+  CHECK(xm.z() > r * std::sqrt(2.0) - 1e-4);
+}
+
+TEST_CASE("a mesh wall's contact slots are saved and restored: a restart in a crease is bit for bit", "[walls][checkpoint]") {
+  const auto model = grooveModel({grooveMesh()});
+  // Saved at the first step after 0.1 s where the ball touches the mesh twice.
+  sim::World first(model, {grooveBall()}, 1);
+  sim::WorldState state;
+  auto touchesTwice = [](const sim::WorldState& s) {
+    return std::any_of(s.wall_history.begin(), s.wall_history.end(), [](const sim::WallHistory& h) { return h.slot > 0; });
+  };
+  do {
+    first.step();
+    state = first.exportState();
+  } while (first.time() < 0.1 || !touchesTwice(state));
+  const std::uint64_t steps = first.stepCount() + 5000;
+  sim::World whole(model, {grooveBall()}, 1);
+  while (whole.stepCount() < steps) whole.step();
+  const auto path = std::filesystem::temp_directory_path() / "rocklab-mesh-slots.h5";
+  sim::output::writeCheckpoint(path, state, "scene");
+  auto cp = sim::output::readCheckpoint(path);
+  std::filesystem::remove(path);
+  sim::World second(model, std::move(cp.state), 1);
+  while (second.stepCount() < steps) second.step();
+  CHECK(second.stateHash() == whole.stateHash());
 }
 
 TEST_CASE("a removed gate releases the ball - a moving wall carries it", "[walls]") {

@@ -2,6 +2,7 @@
 
 #include <H5Cpp.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -77,6 +78,16 @@ void writeHistory(const H5::Group& root, const HistoryLayout<History>& layout,
   if (relaxing) writeArray(group, "relax_offset", column(rows, &History::relax_offset), "m");
 }
 
+/// Mesh walls' contact slots and last normals (WallHistory), only when a row has one.
+void writeWallSlots(const H5::Group& root, const std::vector<WallHistory>& rows) {
+  const bool any = std::any_of(rows.begin(), rows.end(),
+                               [](const WallHistory& h) { return h.slot != 0 || !h.normal.isZero(0); });
+  if (!any) return;
+  const H5::Group group = root.openGroup(kWallLayout.group);
+  writeArray(group, "slot", column(rows, &WallHistory::slot), "");
+  writeArray(group, "normal", column(rows, &WallHistory::normal), "");
+}
+
 void writeParticles(const H5::Group& root, const ParticleState& p) {
   const H5::Group group = root.createGroup("particles");
 #define ROCKLAB_WRITE(type, name, unit, meaning) writeArray(group, #name, p.name, unit);
@@ -134,6 +145,7 @@ std::string fileImage(const std::string& name, const WorldState& state, const st
   writeParticles(file, state.particles);
   writeHistory(file, kPairLayout, state.pair_history);
   writeHistory(file, kWallLayout, state.wall_history);
+  writeWallSlots(file, state.wall_history);
   writeBonds(file, state.bonds);
   writeArray(file, "moving_wall_work", std::vector<double>{state.moving_wall_work}, "J");
   if (!experiment_state.empty()) writeArray(file, "experiment", experiment_state, "");
@@ -294,6 +306,22 @@ std::vector<History> readHistory(const Reader& in, const HistoryLayout<History>&
   return rows;
 }
 
+/// writeWallSlots' arrays; a file without them (no mesh wall, or written before
+/// mesh walls had slots) has every contact in slot 0 with no normal.
+void readWallSlots(const Reader& in, std::vector<WallHistory>& rows) {
+  const std::string group = "/" + std::string(kWallLayout.group) + "/";
+  if (!in.has(group + "slot")) return;
+  const auto slot = in.array<std::uint32_t>(group + "slot");
+  const auto normal = in.array<Vec3>(group + "normal");
+  if (slot.size() != rows.size() || normal.size() != rows.size())
+    in.fail("inconsistent array sizes in " + group + ": slot " + std::to_string(slot.size()) + ", normal " +
+            std::to_string(normal.size()) + " (allowed: " + std::to_string(rows.size()) + ", one per row)");
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    rows[k].slot = slot[k];
+    rows[k].normal = normal[k];
+  }
+}
+
 ParticleState readParticles(const Reader& in) {
   ParticleState p;
 #define ROCKLAB_READ(type, name, unit, meaning) p.name = in.array<type>("/particles/" #name);
@@ -345,6 +373,7 @@ Checkpoint readFile(const Reader& in) {
   state.particles = readParticles(in);
   state.pair_history = readHistory(in, kPairLayout);
   state.wall_history = readHistory(in, kWallLayout);
+  readWallSlots(in, state.wall_history);
   state.bonds = readBonds(in);
   if (in.has("/moving_wall_work")) {
     const auto work = in.array<double>("/moving_wall_work");

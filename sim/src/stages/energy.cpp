@@ -30,14 +30,11 @@ Energy World::Impl::energy(const std::vector<Vec3>& v, const std::vector<Vec3>& 
       e.elastic += detail::elasticEnergy<Law>(pairProps(i, j), pairOverlap(touch, k),
                                               effectiveRadius(p.radius[i], p.radius[j]), history.pair_shear[k]);
     }
-    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
-      if (!history.wall_touch[c]) continue;
-      const std::uint32_t wk = nb.wall_index[c];
-      ContactPoint touch;
-      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch)) continue;
-      e.elastic += detail::elasticEnergy<Law>(wallProps(i, wk), wallOverlap(touch, c), p.radius[i],
+    forEachWallTouch(walls, i, [&](std::uint32_t c, std::uint32_t wk, const ContactPoint* touch) {
+      if (!history.wall_touch[c] || !touch) return;
+      e.elastic += detail::elasticEnergy<Law>(wallProps(i, wk), wallOverlap(*touch, c), p.radius[i],
                                               history.wall_shear[c]);
-    }
+    });
   }
   // Contacts of contact bonds that broke in this step: not yet in the pair list.
   for (const PairHistory& h : bonds.handover) {

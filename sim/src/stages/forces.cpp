@@ -69,33 +69,31 @@ template <class Law>
 inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c) {
   const Vec3 xi = p.position[i];
   const double ri = p.radius[i];
-  double moved = -1;  // m since the neighbour build: only for a mesh wall's candidates
-  for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
-    const std::uint32_t wk = nb.wall_index[w];
-    const detail::WallRuntime& wr = walls[wk];
-    ContactPoint touch;
-    const std::span<const std::uint32_t> triangles = nb.trianglesOf(w);
-    if (!triangles.empty() && moved < 0) moved = (xi - nb.ref_position[i]).norm();
-    if (!ballWallTouch(wr, model.walls[wk], xi, ri, triangles, touch, nb.triangleDistancesOf(w), moved)) {
+  // One contact (or none) at candidate w; `slotted`: a mesh wall's, whose normal is kept.
+  auto contact = [&](std::uint32_t w, std::uint32_t wk, const ContactPoint* touch, bool fresh, bool slotted) {
+    if (!touch) {
       history.wall_touch[w] = 0;
       history.wall_shear[w].setZero();
-      if (relax.active()) relax.wall[w] = 0.0;
-      continue;
+      if (slotted) history.wall_normal[w].setZero();
+      if (relax.active()) relax.wall[w] = 0.0;  // separated: a new touch gets the full force
+      return;
     }
+    if (fresh) history.wall_shear[w].setZero();  // the slot's last contact ended
+    if (slotted) history.wall_normal[w] = touch->normal;
     detail::ContactGeometry g;
-    g.normal = touch.normal;
-    g.overlap = touch.overlap;
-    const Vec3 cp = touch.point;
+    g.normal = touch->normal;
+    g.overlap = touch->overlap;
+    const Vec3 cp = touch->point;
     if (relax.active()) {
-      g.overlap = wallOverlap(touch, w);
+      g.overlap = wallOverlap(*touch, w);
       if (g.overlap <= 0) {
         history.wall_touch[w] = 0;
         history.wall_shear[w].setZero();
-        continue;
+        return;
       }
     }
     const Vec3 ai = cp - xi;
-    const Vec3 v_wall = wr.contactVelocityAt(cp, g.normal);  // the spin: tangential only
+    const Vec3 v_wall = walls[wk].contactVelocityAt(cp, g.normal);  // the spin: tangential only
     g.rel_velocity = v_wall - (p.velocity[i] + p.omega[i].cross(ai));
     g.r_tilde = ri;            // mirror-image ball (ref §4.2)
     g.damping_mass = p.mass[i];  // ball–wall dashpot uses the ball's mass (Eq 2-18)
@@ -112,6 +110,22 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
     }
     if (g.overlap > model.watchdog.max_overlap_fraction * ri)
       mergeWorst(c, g.overlap / ri, (std::uint64_t(i) << 32) | kWallBit | wk);
+  };
+  for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1];) {
+    const std::uint32_t wk = nb.wall_index[w];
+    if (model.walls[wk].shape != WallShape::Mesh) {
+      ContactPoint touch;
+      const bool touching = ballWallTouch(walls[wk], model.walls[wk], xi, ri, {}, touch);
+      contact(w, wk, touching ? &touch : nullptr, false, false);
+      ++w;
+      continue;
+    }
+    // A mesh wall: its slots in a row, each touch in its slot (wall_touches.cpp).
+    WallTouches touches;
+    meshWallTouches(walls[wk], i, w, touches, true);
+    for (std::uint32_t s = 0; s < touches.slots; ++s)
+      contact(w + s, wk, touches.has[s] ? &touches.touch[s] : nullptr, touches.fresh[s], true);
+    w += touches.slots;
   }
 }
 

@@ -49,11 +49,15 @@ void World::Impl::rebuildNeighbours() {
   }
   if (!bonds.handover.empty()) takeHandovers();  // pairs of contact bonds broken since the last build
   // Wall candidates: balls within r + skin of an active wall.
+  // A mesh wall takes kMeshWallSlots candidates (wall_touches.cpp), in a row.
   std::vector<std::uint32_t> old_offset = std::move(nb.wall_offset), old_index = std::move(nb.wall_index);
+  std::vector<std::uint8_t> old_slot = std::move(nb.wall_slot);
   std::vector<Vec3> old_wshear = std::move(history.wall_shear);
+  std::vector<Vec3> old_wnormal = std::move(history.wall_normal);
   std::vector<double> old_wrelax = std::move(relax.wall);
   nb.wall_offset.assign(n + 1, 0);
   nb.wall_index.clear();
+  nb.wall_slot.clear();
   nb.wall_triangle_offset.assign(1, 0);
   nb.wall_triangles.clear();
   nb.wall_triangle_distance.clear();
@@ -63,20 +67,26 @@ void World::Impl::rebuildNeighbours() {
       if (!walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles,
                          nb.wall_triangle_distance))
         continue;
-      nb.wall_index.push_back(static_cast<std::uint32_t>(k));
-      nb.wall_triangle_offset.push_back(static_cast<std::uint32_t>(nb.wall_triangles.size()));
+      const std::uint32_t slots = model.walls[k].shape == WallShape::Mesh ? kMeshWallSlots : 1;
+      for (std::uint32_t s = 0; s < slots; ++s) {
+        nb.wall_index.push_back(static_cast<std::uint32_t>(k));
+        nb.wall_slot.push_back(static_cast<std::uint8_t>(s));
+        nb.wall_triangle_offset.push_back(static_cast<std::uint32_t>(nb.wall_triangles.size()));
+      }
     }
     nb.wall_offset[i + 1] = static_cast<std::uint32_t>(nb.wall_index.size());
   }
   history.wall_shear.assign(nb.wall_index.size(), Vec3::Zero());
   history.wall_touch.assign(nb.wall_index.size(), 0);
+  if (has_mesh_walls) history.wall_normal.assign(nb.wall_index.size(), Vec3::Zero());
   if (carry_relax) relax.wall.assign(nb.wall_index.size(), 0.0);
   if (!old_offset.empty()) {
     for (std::size_t i = 0; i < n; ++i)
       for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c)
         for (std::uint32_t o = old_offset[i]; o < old_offset[i + 1]; ++o)
-          if (old_index[o] == nb.wall_index[c]) {
+          if (old_index[o] == nb.wall_index[c] && old_slot[o] == nb.wall_slot[c]) {
             history.wall_shear[c] = old_wshear[o];
+            if (has_mesh_walls) history.wall_normal[c] = old_wnormal[o];
             if (carry_relax) relax.wall[c] = old_wrelax[o];
           }
   }
@@ -87,7 +97,7 @@ void World::Impl::rebuildNeighbours() {
   assignRanges();
   ++stats.neighbour_rebuilds;
   stats.pairs_in_list = np;
-  stats.wall_candidates = nb.wall_index.size();
+  stats.wall_candidates = static_cast<std::size_t>(std::count(nb.wall_slot.begin(), nb.wall_slot.end(), 0));
   stats.neighbour_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -82,16 +82,13 @@ void World::Impl::visitTouchingContacts(const std::vector<std::int32_t>& body_of
       add(i, body_of[j], touch.normal, touch.point, centre(j), overlap, effectiveRadius(ri, p.radius[j]), md,
           pairProps(i, j), history.pair_shear[q]);
     }
-    for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1]; ++w) {
-      if (!history.wall_touch[w]) continue;
-      const std::uint32_t wk = nb.wall_index[w];
-      ContactPoint touch;
-      if (!ballWallTouch(walls[wk], model.walls[wk], p.position[i], ri, nb.trianglesOf(w), touch)) continue;
-      const double overlap = wallOverlap(touch, w);
-      if (overlap <= 0) continue;
-      add(i, -1, touch.normal, touch.point, touch.point, overlap, ri, p.mass[i], wallProps(i, wk),
+    forEachWallTouch(walls, i, [&](std::uint32_t w, std::uint32_t wk, const ContactPoint* touch) {
+      if (!history.wall_touch[w] || !touch) return;
+      const double overlap = wallOverlap(*touch, w);
+      if (overlap <= 0) return;
+      add(i, -1, touch->normal, touch->point, touch->point, overlap, ri, p.mass[i], wallProps(i, wk),
           history.wall_shear[w]);
-    }
+    });
   }
 }
 

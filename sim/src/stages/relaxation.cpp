@@ -17,14 +17,12 @@ void World::Impl::startRelaxation() {
         any = true;
       }
     }
-    for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; ++c) {
-      const std::uint32_t wk = nb.wall_index[c];
-      ContactPoint touch;
-      if (ballWallTouch(walls[wk], model.walls[wk], p.position[i], p.radius[i], nb.trianglesOf(c), touch) && touch.overlap > 0) {
-        relax.wall[c] = touch.overlap;
+    forEachWallTouch(walls, i, [&](std::uint32_t c, std::uint32_t, const ContactPoint* touch) {
+      if (touch && touch->overlap > 0) {
+        relax.wall[c] = touch->overlap;
         any = true;
       }
-    }
+    });
   }
   if (!any) relax.stop();
 }

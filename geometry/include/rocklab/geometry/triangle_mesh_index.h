@@ -64,6 +64,7 @@ class TriangleMeshIndex {
     Vec3 point;               // closest point on `triangle`
     std::size_t triangle = 0;
     double distance = 0;      // m, |p - point|
+    double distance2 = 0;     // m^2, its square as computed (the order of touches)
   };
   /// Every place where a ball (centre p, radius r) touches the mesh, once each:
   /// the local minima of the distance from p over the surface closer than r. A
@@ -72,8 +73,14 @@ class TriangleMeshIndex {
   /// same contact seen from a neighbour: a flat mesh split into triangles, a
   /// convex ridge or a cone's apex give one touch), and touches at the same point
   /// are merged. A ball in a concave crease touching both faces gets two.
-  /// Sorted by distance, then triangle.
+  /// Sorted by squared distance, then triangle (closestPointAmong's rule).
   std::vector<Touch> touches(const Vec3& p, double r) const;
+  /// touches() over the given triangles only, into `out` (cleared first): the same
+  /// touches when they hold every triangle nearer to p than r (a ball's candidates,
+  /// trianglesWithin with r + skin). With `bounds` the triangles that cannot come
+  /// nearer than r are not tested. The nearest touch is closestPointAmong's point.
+  void touchesAmong(const Vec3& p, double r, std::span<const std::uint32_t> triangles, std::vector<Touch>& out,
+                    const CandidateDistances& bounds = {}) const;
 
  private:
   struct Tree;

@@ -67,7 +67,7 @@ struct Snapshot {
   ROCKLAB_SNAPSHOT_FIELDS(ROCKLAB_SNAPSHOT_SPAN)
   Energy energy;
   std::size_t contacts = 0;       // touching ball–ball pairs
-  std::size_t wall_contacts = 0;  // touching ball–wall pairs
+  std::size_t wall_contacts = 0;  // touching ball–wall contacts (a ball in a mesh's crease touches it twice)
 };
 
 #undef ROCKLAB_SNAPSHOT_SPAN

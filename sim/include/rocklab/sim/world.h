@@ -57,11 +57,21 @@ struct PairHistory {
   Vec3 shear = Vec3::Zero();  // N, shear spring force on i
   double relax_offset = 0.0;  // m, initial overlap still being relaxed (Model::relaxation)
 };
+/// A mesh wall has this many contact slots per ball near it: a ball in a concave
+/// crease or corner of one mesh touches it at two or three places
+/// (TriangleMeshIndex::touches), each a contact with its own shear spring. The
+/// nearest three are kept.
+inline constexpr std::uint32_t kMeshWallSlots = 3;
 /// Contact history of one ball–wall contact.
 struct WallHistory {
   std::uint32_t particle = 0, wall = 0;
   Vec3 shear = Vec3::Zero();  // N, shear spring force on the ball
   double relax_offset = 0.0;  // m, initial overlap still being relaxed (Model::relaxation)
+  // A mesh wall: which of the ball's contacts with it (0, 1, 2: a ball in a
+  // crease touches a mesh twice) and that contact's last unit normal (which
+  // touch continues it). 0 and zero for other walls.
+  std::uint32_t slot = 0;
+  Vec3 normal = Vec3::Zero();
 };
 
 /// Everything that changes during a run: with the Model it restarts a run bit
@@ -90,7 +100,7 @@ const char* stageName(Stage s);
 struct WorldStats {
   std::uint64_t neighbour_rebuilds = 0;
   std::size_t pairs_in_list = 0;
-  std::size_t wall_candidates = 0;
+  std::size_t wall_candidates = 0;  // balls near a wall, counted once a wall (a mesh wall has slots)
   double neighbour_seconds = 0.0;  // s of wall time spent in neighbour-list rebuilds
   std::uint64_t network_checks = 0;  // step checks of the contact network done
   double network_step_ratio = 0.0;   // largest dt / (stable step of the network) they found; stops above 1
