@@ -52,8 +52,11 @@ void World::Impl::checkOverlap(const StepChecks& checks) const {
     << model.watchdog.max_overlap_fraction
     << ". Either the particles were created overlapping (relaxation.steps eases initial overlaps apart), "
        "the contacts are too soft for the loads or impact speeds (a linear impact at v overlaps "
-       "v sqrt(m/k): stiffen them), or "
-    << stepAdvice();
+       "v sqrt(m/k): stiffen them), "
+    << ((low & kWallBit) ? "the ball is pinched where walls close to less than its size (a crusher's gap "
+                           "without breakage: [experiment.breakage]), "
+                         : "")
+    << "or the step is too large. " << stepAdvice();
   throw WatchdogError(s.str());
 }
 
