@@ -428,3 +428,16 @@ TEST_CASE("every documented scene key names its table and says what it does", "[
     CHECK(std::string(k.text).find('|') == std::string::npos);  // a Markdown table cell
   }
 }
+
+TEST_CASE("a --set key path's unit, for axis labels, from the scene reference", "[scene]") {
+  CHECK(sceneKeyUnit("walls.top.corner.2") == "m");  // the zoned chute's CSS
+  CHECK(sceneKeyUnit("walls.top.angle_deg") == "deg");
+  CHECK(sceneKeyUnit("particles.0.member_radius") == "m");
+  CHECK(sceneKeyUnit("experiment.inclination_deg") == "deg");
+  CHECK(sceneKeyUnit("experiment.breakage.q_ref") == "Pa");
+  CHECK(sceneKeyUnit("scene.seed").empty());       // a number without a unit
+  CHECK(sceneKeyUnit("walls.top.no_such_key").empty());
+  CHECK(sceneKeyUnit("seed").empty());
+  CHECK(withSceneKeyUnit("walls.top.corner.2") == "walls.top.corner.2 (m)");
+  CHECK(withSceneKeyUnit("scene.seed") == "scene.seed");
+}

@@ -18,6 +18,7 @@
 #include "common/joined_text.h"
 #include "common/json_text.h"
 #include "rocklab/experiments/run.h"
+#include "scene/scene_keys.h"
 #include "sets/plan_file.h"
 #include "sets/run_set.h"
 
@@ -300,7 +301,9 @@ PlotSpec samplesPlot(const Merged& m, std::size_t figure, std::size_t samples) {
   PlotSpec spec;
   spec.title = m.figures[figure] + " over " + std::to_string(samples) +
                " samples: each sample a point, the mean a line where every sample has it";
-  spec.x_label = !x_key ? "variant (row of samples.csv)" : divisor ? m.keys[*x_key] + " / " + m.x_over : m.keys[*x_key];
+  spec.x_label = !x_key     ? "variant (row of samples.csv)"
+                 : divisor ? m.keys[*x_key] + " / " + m.x_over
+                           : withSceneKeyUnit(m.keys[*x_key]);
   spec.y_label = m.figures[figure];
   std::map<std::string, std::vector<std::size_t>> groups;  // by the other keys' values
   std::vector<std::string> group_order;

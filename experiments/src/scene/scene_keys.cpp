@@ -367,6 +367,33 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
   return docs;
 }
 
+std::string sceneKeyUnit(const std::string& path) {
+  // The path's parts; the key is the last part that is not an index.
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  for (std::string part; std::getline(in, part, '.');) parts.push_back(part);
+  while (!parts.empty() && !parts.back().empty() &&
+         parts.back().find_first_not_of("0123456789") == std::string::npos)
+    parts.pop_back();
+  if (parts.size() < 2) return "";
+  const std::string& key = parts.back();
+  std::string unit;
+  bool found = false;
+  for (const KeyDoc& d : sceneKeyDocs()) {
+    const std::string table = d.table;
+    if (key != d.key || table.substr(0, table.find('.')) != parts.front()) continue;
+    if (found && unit != d.unit) return "";  // the tables that have the name disagree
+    unit = d.unit;
+    found = true;
+  }
+  return unit;
+}
+
+std::string withSceneKeyUnit(const std::string& path) {
+  const std::string unit = sceneKeyUnit(path);
+  return unit.empty() ? path : path + " (" + unit + ")";
+}
+
 namespace {
 
 /// Scenes that reach the reader branches the built-in scenes do not (every wall

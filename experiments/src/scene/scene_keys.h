@@ -29,6 +29,14 @@ struct KeyDoc {
 /// Every documented table and key, in the order of the reference.
 const std::vector<KeyDoc>& sceneKeyDocs();
 
+/// The SI unit of a --set/--vary key path ("walls.top.corner.2" -> "m",
+/// "particles.0.member_radius" -> "m", "scene.seed" -> ""): the documented key of
+/// that name in a table of the path's first part; "" when none is documented or
+/// the tables that have the name disagree. For axis labels.
+std::string sceneKeyUnit(const std::string& path);
+/// "PATH (UNIT)", or PATH when it has no unit.
+std::string withSceneKeyUnit(const std::string& path);
+
 /// Loads the corpus with key recording on and returns the reference as
 /// Markdown; every problem (undocumented key, documented key never read,
 /// default that differs between scenes) is appended to `problems`.

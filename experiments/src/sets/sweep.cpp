@@ -18,6 +18,7 @@
 #include "sets/run_set.h"
 #include "sets/study_report.h"
 #include "report/set_report.h"
+#include "scene/scene_keys.h"
 #include "rocklab/experiments/run.h"
 #include "rocklab/experiments/scene.h"
 
@@ -141,7 +142,7 @@ int reportSweep(const std::filesystem::path& dir, const SweepOptions& o, const s
   PlotSpec spec;
   const std::string x_name = o.x_over.empty() ? o.vary.front().first : o.vary.front().first + " / " + o.x_over;
   spec.title = name + ": " + metrics.front() + " against " + x_name;
-  spec.x_label = x_name;
+  spec.x_label = o.x_over.empty() ? withSceneKeyUnit(x_name) : x_name;
   spec.y_label = metrics.front();
   const std::size_t groups = o.vary.size() > 1 ? o.vary[1].second.size() : 1;
   for (std::size_t g = 0; g < groups; ++g) {
