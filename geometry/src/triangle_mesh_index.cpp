@@ -41,13 +41,9 @@ struct TriangleMeshIndex::Tree {
 
 namespace {
 
-/// The vertices of triangle f on which q lies: one (a vertex), two (an edge) or
-/// none (inside the face).
-struct Feature {
-  std::array<std::uint32_t, 3> vertex{};
-  int count = 0;
-};
-Feature featureOf(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f, const Vec3& q) {
+/// Whether q (a point of triangle f) lies on one of its edges or vertices rather
+/// than inside the face.
+bool onEdgeOrVertex(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f, const Vec3& q) {
   const Vec3 a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], c = mesh.vertices[f[2]];
   const Vec3 n = (b - a).cross(c - a);
   const double area2 = n.squaredNorm();
@@ -55,11 +51,7 @@ Feature featureOf(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& 
   const double w[3] = {(c - b).cross(q - b).dot(n) / area2, (a - c).cross(q - c).dot(n) / area2,
                        (b - a).cross(q - a).dot(n) / area2};
   constexpr double kOnEdge = 1e-9;
-  Feature on;
-  for (int k = 0; k < 3; ++k)
-    if (w[k] > kOnEdge) on.vertex[on.count++] = f[k];
-  if (on.count == 3) on.count = 0;
-  return on;
+  return !(w[0] > kOnEdge && w[1] > kOnEdge && w[2] > kOnEdge);
 }
 
 }  // namespace
@@ -172,8 +164,8 @@ namespace {
 /// The touches among `candidates` (every triangle nearer to p than r, each with
 /// its closest point and distance, in any order), once each: the rule of
 /// TriangleMeshIndex::touches. An edge or vertex touch is the same contact as a
-/// neighbour's when a triangle sharing that feature comes closer; such a
-/// triangle is nearer than r too, so it is among the candidates.
+/// neighbour's when a nearer triangle holds that point (it shares the edge or
+/// vertex); such a triangle is nearer than r too, so it is among the candidates.
 void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, double r,
                  std::vector<TriangleMeshIndex::Touch>& out) {
   using Touch = TriangleMeshIndex::Touch;
@@ -186,20 +178,21 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
     return;
   }
   std::sort(candidates.begin(), candidates.end(), byDistance);
-  auto holds = [&](std::size_t triangle, std::uint32_t vertex) {
+  // Whether q lies on a triangle: by geometry, not by shared vertex indices, so
+  // that an edge between parts not welded together counts as shared too.
+  auto holds = [&](std::size_t triangle, const Vec3& q) {
     const auto& f = mesh.triangles[triangle];
-    return f[0] == vertex || f[1] == vertex || f[2] == vertex;
+    const Vec3 on = closestPointOnTriangle(q, mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]);
+    return (on - q).norm() <= 1e-9 * r;
   };
   for (const Touch& c : candidates) {
-    const Feature on = featureOf(mesh, mesh.triangles[c.triangle], c.point);
     bool shadowed = false;
-    if (on.count > 0) {
+    if (onEdgeOrVertex(mesh, mesh.triangles[c.triangle], c.point)) {
       // Relative tolerance: ties are kept here and merged below.
       for (const Touch& o : candidates) {
         if (o.distance >= c.distance * (1 - 1e-12) - 1e-300) break;  // sorted: no nearer one follows
         if (o.triangle == c.triangle) continue;
-        if (std::all_of(on.vertex.begin(), on.vertex.begin() + on.count,
-                        [&](std::uint32_t v) { return holds(o.triangle, v); })) {
+        if (holds(o.triangle, c.point)) {
           shadowed = true;
           break;
         }

@@ -137,6 +137,26 @@ TEST_CASE("a ball's touches on a mesh - one per contact and two in a concave cre
   const Vec3 up_left(-0.03, 0.03, 0.03 + r * std::sqrt(2.0) - 1e-4);
   CHECK(v.touches(up_left, r).size() == 1);
   CHECK(v.touches(Vec3(0, 0.0, r - 1e-4), r).size() == 2);  // right above the crease line
+  // The same faces as parts not welded together (each triangle its own vertices):
+  // the touches are found by geometry, not by shared vertex indices, so a flat
+  // floor near or over a seam still gives one touch and the groove two.
+  auto unwelded = [](const TriangleMesh& m) {
+    TriangleMesh u;
+    for (const auto& f : m.triangles) {
+      const auto base = static_cast<std::uint32_t>(u.vertices.size());
+      for (int k = 0; k < 3; ++k) u.vertices.push_back(m.vertices[f[k]]);
+      u.triangles.push_back({base, base + 1, base + 2});
+    }
+    return u;
+  };
+  const TriangleMeshIndex loose_grid(unwelded(flat));
+  for (const Vec3& p : {Vec3(0.05, 0.002, 0.009), Vec3(0.05, 0.0, 0.009), Vec3(0.0, 0.0, 0.009), Vec3(0.1, 0.1, 0.009),
+                        Vec3(-0.1, -0.1, 0.009)}) {
+    INFO("ball at " << p.transpose() << " over the unwelded grid");
+    CHECK(loose_grid.touches(p, 0.01).size() == 1);
+  }
+  CHECK(TriangleMeshIndex(unwelded(groove)).touches(rest, r).size() == 2);
+  CHECK(TriangleMeshIndex(unwelded(groove)).touches(up_left, r).size() == 1);
   // A convex ridge (the groove upside down) and a cone's apex: one touch each.
   TriangleMesh ridge = groove;
   for (Vec3& p : ridge.vertices) p.z() = -p.z();
