@@ -10,8 +10,8 @@ namespace rocklab::sim {
 // spring while the ball rolls along a crease or over a ridge; a new touch takes
 // a free slot. With one touch at a time this is slot 0 throughout, the contact
 // of a single-contact search bit for bit (and its spring carried as before).
-void World::Impl::meshWallTouches(const detail::WallRuntime& runtime, std::size_t i, std::uint32_t c,
-                                  WallTouches& out, bool bounded) const {
+void World::Impl::meshWallTouches(const detail::WallRuntime& runtime, std::size_t i,
+                                  std::uint32_t c, WallTouches& out, bool bounded) const {
   out.slots = kMeshWallSlots;
   out.has.fill(false);
   out.fresh.fill(false);
@@ -51,7 +51,8 @@ void World::Impl::meshWallTouches(const detail::WallRuntime& runtime, std::size_
       if (!taken[s]) pick = static_cast<int>(s);
     slot_of[t] = pick;  // count <= kMeshWallSlots: there is one
     taken[static_cast<std::size_t>(pick)] = true;
-    out.fresh[static_cast<std::size_t>(pick)] = !history.wall_normal[c + static_cast<std::uint32_t>(pick)].isZero(0);
+    out.fresh[static_cast<std::size_t>(pick)] =
+        !history.wall_normal[c + static_cast<std::uint32_t>(pick)].isZero(0);
   }
   for (std::size_t t = 0; t < count; ++t) {
     const auto s = static_cast<std::size_t>(slot_of[t]);
