@@ -73,7 +73,7 @@ class WallRuntime {
   /// Whether x is nearer than `range` to the wall (planes: signed distance, so a
   /// point behind is near). A mesh wall also appends the triangles nearer than
   /// `range` (nearest first) to `triangles` and their distances to `distances`: a
-  /// ball's candidates until the next neighbour build (contact()).
+  /// ball's candidates until the next neighbour build (meshTouches()).
   bool near(const Wall& w, const Vec3& x, double range, std::vector<std::uint32_t>& triangles,
             std::vector<double>& distances) const {
     if (w.shape != WallShape::Mesh) return distance(w, x) < range;
@@ -82,14 +82,9 @@ class WallRuntime {
     return triangles.size() > before;
   }
 
-  /// Contact of a ball (centre x, radius r) with the wall; false when apart. A
-  /// mesh wall looks only at `triangles`, the ball's candidates of the last
-  /// neighbour build (near() with r + skin): the same contact as a search
-  /// of the whole mesh while the ball and the wall have moved less than the skin.
-  /// With `distances` (near()'s) and how far the ball has moved since
-  /// (`ball_moved`, m) it stops at the first candidate that cannot be the nearest.
-  bool contact(const Wall& w, const Vec3& x, double r, std::span<const std::uint32_t> triangles,
-               WallContact& out, std::span<const double> distances = {}, double ball_moved = 0) const {
+  /// Contact of a ball (centre x, radius r) with a plane or polygon wall; false
+  /// when apart. A mesh wall's contacts are meshTouches().
+  bool contact(const Wall& w, const Vec3& x, double r, WallContact& out) const {
     const Vec3 xb = toBody(x);
     if (w.shape == WallShape::Plane) {
       // One-sided: a ball behind the plane is still pushed out along its normal.
@@ -99,15 +94,7 @@ class WallRuntime {
       out.overlap = r - d;
       return true;
     }
-    Vec3 q;
-    if (w.shape == WallShape::Mesh) {
-      if (!mesh_index_.closestPointAmong(xb, r, triangles, q,
-                                         {distances, ball_moved + displacementSinceReference()}))
-        return false;
-    } else {
-      q = closestInBody(w, xb);
-    }
-    const Vec3 diff = xb - q;
+    const Vec3 diff = xb - closestInBody(w, xb);
     const double d2 = diff.squaredNorm();
     if (d2 >= r * r) return false;
     const double d = std::sqrt(d2);
@@ -119,9 +106,12 @@ class WallRuntime {
   }
 
   /// A mesh wall's touches of a ball (centre x, radius r), nearest first, at most
-  /// out.size() of them (TriangleMeshIndex::touchesAmong over the ball's candidate
-  /// `triangles`, with contact()'s bounds); returns how many. The nearest is
-  /// contact()'s contact, bit for bit.
+  /// out.size() of them; returns how many. Only `triangles` are looked at, the
+  /// ball's candidates of the last neighbour build (near() with r + skin): the
+  /// same touches as a search of the whole mesh while the ball and the wall have
+  /// moved less than the skin (TriangleMeshIndex::touchesAmong). With `distances`
+  /// (near()'s) and how far the ball has moved since (`ball_moved`, m) the
+  /// triangles that cannot come within r are not tested.
   std::size_t meshTouches(const Vec3& x, double r, std::span<const std::uint32_t> triangles,
                           std::span<WallContact> out, std::span<const double> distances = {},
                           double ball_moved = 0) const {

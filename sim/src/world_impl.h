@@ -95,16 +95,12 @@ struct ContactPoint {
   g.point = xi + g.normal * (ri - 0.5 * g.overlap);
 }
 
-/// A ball against an active wall; false when apart or the wall is not there.
-/// `triangles`: a mesh wall's candidate triangles for this ball (NeighbourLists);
-/// with their `distances` at the build and how far the ball moved since
-/// (`ball_moved`, m) fewer of them are tested (WallRuntime::contact).
+/// A ball against an active plane or polygon wall; false when apart or the wall
+/// is not there (a mesh wall's contacts: World::Impl::wallTouches).
 [[gnu::always_inline]] inline bool ballWallTouch(const detail::WallRuntime& runtime, const Wall& wall,
-                                                 const Vec3& xi, double ri, std::span<const std::uint32_t> triangles,
-                                                 ContactPoint& g, std::span<const double> distances = {},
-                                                 double ball_moved = 0) {
+                                                 const Vec3& xi, double ri, ContactPoint& g) {
   detail::WallContact wc;
-  if (!runtime.active || !runtime.contact(wall, xi, ri, triangles, wc, distances, ball_moved)) return false;
+  if (!runtime.active || !runtime.contact(wall, xi, ri, wc)) return false;
   g.normal = wc.normal;
   g.overlap = wc.overlap;
   g.point = xi + g.normal * (ri - 0.5 * g.overlap);
@@ -341,25 +337,25 @@ struct World::Impl {
   /// the slots whose last normal (history.wall_normal) is nearest to theirs, when
   /// within kSameContactCos, and the rest into free slots, lowest first: a
   /// contact keeps its shear spring while the ball moves along a crease.
-  /// `bounded`: skip the triangles that cannot be touched, from the ball's
-  /// distance moved since the build (the force pass; positions of the build).
   [[gnu::always_inline]] void wallTouches(const std::vector<detail::WallRuntime>& runtime, std::size_t i,
-                                          std::uint32_t c, WallTouches& out, bool bounded = false) const {
+                                          std::uint32_t c, WallTouches& out) const {
     const std::uint32_t wk = nb.wall_index[c];
-    if (model.walls[wk].shape == WallShape::Mesh) return meshWallTouches(runtime[wk], i, c, out, bounded);
+    if (model.walls[wk].shape == WallShape::Mesh) return meshWallTouches(runtime[wk], i, c, out, false);
     out.slots = 1;
     out.fresh[0] = false;
-    out.has[0] = ballWallTouch(runtime[wk], model.walls[wk], p.position[i], p.radius[i], {}, out.touch[0]);
+    out.has[0] = ballWallTouch(runtime[wk], model.walls[wk], p.position[i], p.radius[i], out.touch[0]);
   }
+  /// A mesh wall's part of wallTouches (wall_touches.cpp). `bounded`: skip the
+  /// triangles that cannot be touched, from the ball's distance moved since the
+  /// neighbour build (the force pass, which alone may assume it is under the skin).
   void meshWallTouches(const detail::WallRuntime& runtime, std::size_t i, std::uint32_t c, WallTouches& out,
                        bool bounded) const;
   /// Calls visit(c, wall, touch or nullptr) for every wall candidate of ball i.
   template <class Visit>
-  void forEachWallTouch(const std::vector<detail::WallRuntime>& runtime, std::size_t i, Visit&& visit,
-                        bool bounded = false) const {
+  void forEachWallTouch(const std::vector<detail::WallRuntime>& runtime, std::size_t i, Visit&& visit) const {
     WallTouches t;
     for (std::uint32_t c = nb.wall_offset[i]; c < nb.wall_offset[i + 1]; c += t.slots) {
-      wallTouches(runtime, i, c, t, bounded);
+      wallTouches(runtime, i, c, t);
       for (std::uint32_t s = 0; s < t.slots; ++s) visit(c + s, nb.wall_index[c], t.has[s] ? &t.touch[s] : nullptr);
     }
   }

@@ -2,6 +2,7 @@
 // and vertices); polygons, moving walls, removal.
 #include <catch2/catch.hpp>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 
@@ -293,11 +294,12 @@ TEST_CASE("a spinning faceted frustum wall: the contact velocity has no spin nor
     // A ball centre just outside the surface at mid-height (radius 0.1 there).
     const Vec3 radial(std::cos(azimuth), std::sin(azimuth), 0.0);
     const Vec3 centre = Vec3(0, 0, 0.05) + (0.1 + 0.7 * r) * radial;
-    sim::detail::WallContact touch;
+    std::array<sim::detail::WallContact, 1> nearest;
     std::vector<std::uint32_t> triangles;
     std::vector<double> distances;
     REQUIRE(runtime.near(mantle, centre, r, triangles, distances));
-    REQUIRE(runtime.contact(mantle, centre, r, triangles, touch));
+    REQUIRE(runtime.meshTouches(centre, r, triangles, nearest) == 1);
+    const sim::detail::WallContact& touch = nearest[0];
     const Vec3 n = touch.normal;
     const Vec3 point = centre + (r - touch.overlap) * n;
     const Vec3 omega_x_r = spin * Vec3::UnitZ().cross(point);

@@ -114,8 +114,10 @@ inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChec
   for (std::uint32_t w = nb.wall_offset[i]; w < nb.wall_offset[i + 1];) {
     const std::uint32_t wk = nb.wall_index[w];
     if (model.walls[wk].shape != WallShape::Mesh) {
+      // A plane or polygon: its one contact, as wallTouches gives it, without the
+      // slots' scratch (the pass alone searches a mesh's triangles bounded).
       ContactPoint touch;
-      const bool touching = ballWallTouch(walls[wk], model.walls[wk], xi, ri, {}, touch);
+      const bool touching = ballWallTouch(walls[wk], model.walls[wk], xi, ri, touch);
       contact(w, wk, touching ? &touch : nullptr, false, false);
       ++w;
       continue;
