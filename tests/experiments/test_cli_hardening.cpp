@@ -193,6 +193,15 @@ TEST_CASE("an earlier run in --out is refused without --overwrite and cleared wi
   CHECK(r["status"] == "completed");
   CHECK(r["simulated_time_s"].get<double>() == Approx(0.0015).margin(1e-5));
   CHECK(rocklab::sim::output::readCheckpoint(out / "checkpoint.h5").state.step == r["steps"].get<std::uint64_t>());
+  // ...and the checkpoint it continues from is kept until the run writes its own: a
+  // continuation that writes none (or is stopped first) leaves the way back intact.
+  const std::string kept = slurp(out / "checkpoint.h5");
+  o = run({"restart", (out / "checkpoint.h5").string(), "--out", out.string(), "--overwrite", "--quiet", "--set",
+           "scene.end_time=0.002", "--set", "output.checkpoint=false"});
+  CHECK(o.code == 0);
+  CHECK(json::parse(slurp(out / "results.json"))["simulated_time_s"].get<double>() == Approx(0.002).margin(1e-5));
+  REQUIRE(fs::exists(out / "checkpoint.h5"));
+  CHECK(slurp(out / "checkpoint.h5") == kept);
   fs::remove_all(out);
 }
 

@@ -46,12 +46,20 @@ bool runOutput(const fs::path& entry) {
   return false;
 }
 
-/// Removes the earlier run's outputs from `dir`; "" or what failed.
-std::string clearEarlierRun(const fs::path& dir) {
+/// True when `entry` is the file `keep` names ("" keeps nothing).
+bool sameFile(const fs::path& entry, const fs::path& keep) {
+  std::error_code ec;
+  return !keep.empty() && fs::equivalent(entry, keep, ec);
+}
+
+/// Removes the earlier run's outputs from `dir` but `keep` (the checkpoint a restart
+/// continues from: until the continued run writes its own, it is the only way back to
+/// that state, so a run stopped early loses nothing); "" or what failed.
+std::string clearEarlierRun(const fs::path& dir, const fs::path& keep) {
   std::error_code ec;
   std::vector<fs::path> outputs;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-    if (runOutput(e.path())) outputs.push_back(e.path());
+    if (runOutput(e.path()) && !sameFile(e.path(), keep)) outputs.push_back(e.path());
   if (ec) return "cannot list " + dir.string() + ": " + ec.message();
   for (const fs::path& p : outputs) {
     fs::remove_all(p, ec);
@@ -89,11 +97,12 @@ int prepareOutputFolder(const RunOptions& options, std::ostream& log) {
       return kExitBadInput;
     }
     if (!marks.empty() && options.earlier_run == EarlierRun::Replace) {
-      if (const std::string why = clearEarlierRun(dir); !why.empty()) {
+      if (const std::string why = clearEarlierRun(dir, options.restart); !why.empty()) {
         log << "error: cannot clear the earlier run in " << where << ": " << why << "\n";
         return kExitBadInput;
       }
-      log << "rocklab: " << where << ": the earlier run (" << joinedText(marks) << ") removed (--overwrite)\n";
+      log << "rocklab: " << where << ": the earlier run (" << joinedText(marks) << ") removed (--overwrite)"
+          << (sameFile(dir / "checkpoint.h5", options.restart) ? ", but the checkpoint this run continues from\n" : "\n");
     }
   }
   fs::create_directories(dir, ec);
