@@ -69,17 +69,32 @@ struct ContactPoint {
   Vec3 point = Vec3::Zero();    // m, the middle of the overlap (the torque arms' end)
 };
 
+/// The contact of ball i at xi (radius ri) with ball j at xi + d, |d|^2 = dist2,
+/// once the test below found them touching: unit normal from i towards j, overlap
+/// (m) and the middle of the overlap. Separate outputs, not a ContactPoint: the
+/// force pass keeps them in registers (through a struct copied into the contact
+/// law's input, the compiler kept the normal in memory).
+[[gnu::always_inline]] inline void touchingBallGeometry(const Vec3& xi, const Vec3& d, double dist2, double ri,
+                                                        double rj, Vec3& normal, double& overlap, Vec3& point) {
+  const double dist = std::sqrt(dist2);
+  normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
+  overlap = (ri + rj) - dist;
+  point = xi + normal * (ri - 0.5 * overlap);
+}
+
+/// Whether balls i and j are apart, from d = xj - xi and their radii.
+[[gnu::always_inline]] inline bool ballsApart(double dist2, double ri, double rj) {
+  const double rsum = ri + rj;
+  return dist2 >= rsum * rsum;
+}
+
 /// Ball i at xi (radius ri) against ball j; false when they are apart.
 [[gnu::always_inline]] inline bool ballBallTouch(const Vec3& xi, const Vec3& xj, double ri, double rj,
                                                  ContactPoint& g) {
   const Vec3 d = xj - xi;
-  const double rsum = ri + rj;
   const double dist2 = d.squaredNorm();
-  if (dist2 >= rsum * rsum) return false;
-  const double dist = std::sqrt(dist2);
-  g.normal = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3(Vec3::UnitZ());
-  g.overlap = rsum - dist;
-  g.point = xi + g.normal * (ri - 0.5 * g.overlap);
+  if (ballsApart(dist2, ri, rj)) return false;
+  touchingBallGeometry(xi, d, dist2, ri, rj, g.normal, g.overlap, g.point);
   return true;
 }
 
@@ -388,6 +403,14 @@ struct World::Impl {
   void forceStage(const StepPlan& plan, StepChecks& checks);
   template <class Law>
   bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
+  template <class Law>
+  bool evaluateTouchingPair(std::size_t i, std::uint32_t j, std::uint32_t k, const Vec3& xi, double ri, double rj,
+                            const Vec3& d, double dist2, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
+  void pairApart(std::uint32_t k) {
+    history.pair_touch[k] = 0;
+    history.pair_shear[k].setZero();
+    if (relax.active()) relax.pair[k] = 0.0;  // separated: a new touch gets the full force
+  }
   template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
   // 4. bonds (stages/bonds.cpp; contact bonds in stages/contact_bonds.cpp)

@@ -24,30 +24,41 @@ namespace rocklab::sim {
 template <class Law>
 [[gnu::always_inline]] inline bool World::Impl::evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj,
                                       Vec3& tj, StepChecks& c) {
-  const bool damped = model.contact.damping_normal > 0 || model.contact.damping_shear > 0;
   const std::uint32_t j = nb.pairs.partner[k];
   const Vec3 xi = p.position[i];
   const double ri = p.radius[i], rj = p.radius[j];
-  ContactPoint touch;
-  if (!ballBallTouch(xi, p.position[j], ri, rj, touch)) {
-    history.pair_touch[k] = 0;
-    history.pair_shear[k].setZero();
-    if (relax.active()) relax.pair[k] = 0.0;  // separated: a new touch gets the full force
+  const Vec3 d = p.position[j] - xi;
+  const double dist2 = d.squaredNorm();
+  if (ballsApart(dist2, ri, rj)) {
+    pairApart(k);
     return false;
   }
+  return evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, c);
+}
+
+// Pair k = (i, j) whose test found them touching (d = xj - xi, dist2 = |d|^2): the
+// contact law; false when the relaxing initial overlap leaves no force.
+template <class Law>
+[[gnu::always_inline]] inline bool World::Impl::evaluateTouchingPair(std::size_t i, std::uint32_t j, std::uint32_t k,
+                                                                     const Vec3& xi, double ri, double rj, const Vec3& d,
+                                                                     double dist2, Vec3& fi, Vec3& ti, Vec3& fj,
+                                                                     Vec3& tj, StepChecks& c) {
+  const bool damped = model.contact.damping_normal > 0 || model.contact.damping_shear > 0;
+  Vec3 n, cp;
+  double overlap;
+  touchingBallGeometry(xi, d, dist2, ri, rj, n, overlap, cp);
   detail::ContactGeometry g;
-  g.normal = touch.normal;
-  g.overlap = touch.overlap;
+  g.normal = n;
+  g.overlap = overlap;
   if (relax.active()) {
     // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
-    g.overlap = pairOverlap(touch, k);
+    g.overlap = overlap - relax.factor * relax.pair[k];
     if (g.overlap <= 0) {
       history.pair_touch[k] = 0;
       history.pair_shear[k].setZero();
       return false;
     }
   }
-  const Vec3 cp = touch.point;
   const Vec3 ai = cp - xi, aj = cp - p.position[j];
   g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
   g.r_tilde = effectiveRadius(ri, rj);  // Eq 2-24
@@ -168,20 +179,44 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
       scratch.acc_torque[q] = t;
     }
     // ...then every ball's own row (scattering to partners in the range) and walls.
+    // The touch test reads through local pointers with the row's ball in registers:
+    // through the members, every store into the history would make the compiler
+    // reload the arrays' addresses and the ball's position for the next pair, on the
+    // chain of loads each apart pair waits for.
+    const Vec3* const position = p.position.data();  // the fused kick writes it: not restrict
+    const double* __restrict const radius = p.radius.data();
+    const std::uint32_t* __restrict const partner = nb.pairs.partner.data();
+    // An apart pair's history cleared through locals too: a byte store may alias
+    // anything, so through the members each would reload the vectors' addresses.
+    std::uint8_t* const touched = history.pair_touch.data();
+    Vec3* const shear = history.pair_shear.data();
+    double* const relax_offset = relax.active() ? relax.pair.data() : nullptr;
     for (std::uint32_t i = b; i < e; ++i) {
       Vec3 f = scratch.acc_force[i], t = scratch.acc_torque[i];
-      for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k) {
+      const Vec3 xi = position[i];
+      const double ri = radius[i];
+      const std::uint32_t row_end = nb.pairs.row_offset[i + 1];
+      for (std::uint32_t k = nb.pairs.row_offset[i]; k < row_end; ++k) {
         if (crossing && scratch.cross_index[k] != ForceScratch::kNotCross) {
           if (!history.pair_touch[k]) continue;
           f += scratch.cross[scratch.cross_index[k]].fi;
           t += scratch.cross[scratch.cross_index[k]].ti;
           continue;
         }
+        const std::uint32_t j = partner[k];
+        const double rj = radius[j];
+        const Vec3 d = position[j] - xi;
+        const double dist2 = d.squaredNorm();
+        if (ballsApart(dist2, ri, rj)) {  // as pairApart(k)
+          touched[k] = 0;
+          shear[k].setZero();
+          if (relax_offset) relax_offset[k] = 0.0;
+          continue;
+        }
         Vec3 fi, ti, fj, tj;
-        if (!evaluatePair<Law>(i, k, fi, ti, fj, tj, local)) continue;
+        if (!evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, local)) continue;
         f += fi;
         t += ti;
-        const std::uint32_t j = nb.pairs.partner[k];
         scratch.acc_force[j] += fj;
         scratch.acc_torque[j] += tj;
       }
