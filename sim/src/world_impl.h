@@ -341,9 +341,10 @@ struct World::Impl {
     return ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wall].material)];
   }
   /// The overlap the contact law sees while initial overlaps relax (Model::relaxation).
-  double pairOverlap(const ContactPoint& g, std::uint32_t k) const {
-    return relax.active() ? g.overlap - relax.factor * relax.pair[k] : g.overlap;
+  double pairOverlap(double overlap, std::uint32_t k) const {
+    return relax.active() ? overlap - relax.factor * relax.pair[k] : overlap;
   }
+  double pairOverlap(const ContactPoint& g, std::uint32_t k) const { return pairOverlap(g.overlap, k); }
   double wallOverlap(const ContactPoint& g, std::uint32_t c) const {
     return relax.active() ? g.overlap - relax.factor * relax.wall[c] : g.overlap;
   }

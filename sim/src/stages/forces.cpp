@@ -52,7 +52,7 @@ template <class Law>
   g.overlap = overlap;
   if (relax.active()) {
     // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
-    g.overlap = overlap - relax.factor * relax.pair[k];
+    g.overlap = pairOverlap(overlap, k);
     if (g.overlap <= 0) {
       history.pair_touch[k] = 0;
       history.pair_shear[k].setZero();
