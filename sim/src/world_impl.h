@@ -403,15 +403,8 @@ struct World::Impl {
   // 3. forces (stages/forces.cpp: the contact law and the pass in one unit, so it inlines)
   void forceStage(const StepPlan& plan, StepChecks& checks);
   template <class Law>
-  bool evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
-  template <class Law>
   bool evaluateTouchingPair(std::size_t i, std::uint32_t j, std::uint32_t k, const Vec3& xi, double ri, double rj,
                             const Vec3& d, double dist2, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
-  void pairApart(std::uint32_t k) {
-    history.pair_touch[k] = 0;
-    history.pair_shear[k].setZero();
-    if (relax.active()) relax.pair[k] = 0.0;  // separated: a new touch gets the full force
-  }
   template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
   // 4. bonds (stages/bonds.cpp; contact bonds in stages/contact_bonds.cpp)

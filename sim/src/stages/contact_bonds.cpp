@@ -69,7 +69,7 @@ std::uint8_t World::Impl::contactBondStep(std::size_t k, StepChecks& c) {
   const double r_small = std::min(ri, rj);
   if (touch.overlap > model.watchdog.max_overlap_fraction * r_small)
     mergeWorst(c, touch.overlap / r_small, (std::uint64_t(i) << 32) | j);
-  // As evaluatePair: force on i, its arm; minus it on j.
+  // As the force pass's evaluateTouchingPair: force on i, its arm; minus it on j.
   const Vec3 ti = ai.cross(force_i);
   const Vec3 force_j = -force_i;
   const Vec3 tj = aj.cross(force_j);

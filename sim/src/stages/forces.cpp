@@ -9,7 +9,7 @@ namespace rocklab::sim {
 // touching flags), the watchdog's wall work, the step checks; on fused steps
 // the integrated state as stage 8 would.
 // The contact law, the pass and its caller are in this one unit so that
-// evaluatePair and addWallForces inline into the pass.
+// evaluateTouchingPair and addWallForces inline into the pass.
 //
 // Each thread owns a contiguous range of balls [b, e). A pair (i, j), i < j, is
 // evaluated once. Its force on j is added straight into j's accumulator when j is
@@ -20,21 +20,6 @@ namespace rocklab::sim {
 // any number of threads, so results are bitwise independent of the thread count.
 // A ball is complete once its own row is done (later balls never read it in this
 // step), so it is integrated right there unless an observer needs the forces.
-
-template <class Law>
-[[gnu::always_inline]] inline bool World::Impl::evaluatePair(std::size_t i, std::uint32_t k, Vec3& fi, Vec3& ti, Vec3& fj,
-                                      Vec3& tj, StepChecks& c) {
-  const std::uint32_t j = nb.pairs.partner[k];
-  const Vec3 xi = p.position[i];
-  const double ri = p.radius[i], rj = p.radius[j];
-  const Vec3 d = p.position[j] - xi;
-  const double dist2 = d.squaredNorm();
-  if (ballsApart(dist2, ri, rj)) {
-    pairApart(k);
-    return false;
-  }
-  return evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, c);
-}
 
 // Pair k = (i, j) whose test found them touching (d = xj - xi, dist2 = |d|^2): the
 // contact law; false when the relaxing initial overlap leaves no force.
@@ -154,12 +139,38 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
     const int th = omp_get_thread_num();
     const std::uint32_t b = scratch.range_begin[th], e = scratch.range_begin[th + 1];
     StepChecks local;
+    // Pair k of ball i (at xi, radius ri; j its partner): the touch test, an apart
+    // pair's history cleared, a touching pair's law; both phases take this path.
+    // It reads through local pointers with ball i in registers: through the members,
+    // every store into the history (a byte, which may alias anything) made the
+    // compiler reload the arrays' addresses and the ball's position for the next
+    // pair, on the chain of loads each apart pair waits for.
+    const Vec3* const position = p.position.data();  // the fused kick writes it: not restrict
+    const double* __restrict const radius = p.radius.data();
+    const std::uint32_t* __restrict const partner = nb.pairs.partner.data();
+    std::uint8_t* const touched = history.pair_touch.data();
+    Vec3* const shear = history.pair_shear.data();
+    double* const relax_offset = relax.active() ? relax.pair.data() : nullptr;
+    auto evaluatePair = [&](std::uint32_t i, const Vec3& xi, double ri, std::uint32_t k, std::uint32_t j, Vec3& fi,
+                            Vec3& ti, Vec3& fj, Vec3& tj) __attribute__((always_inline)) {
+      const double rj = radius[j];
+      const Vec3 d = position[j] - xi;
+      const double dist2 = d.squaredNorm();
+      if (ballsApart(dist2, ri, rj)) {
+        touched[k] = 0;
+        shear[k].setZero();
+        if (relax_offset) relax_offset[k] = 0.0;  // separated: a new touch gets the full force
+        return false;
+      }
+      return evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, local);
+    };
     // Phase A: pairs whose second ball belongs to a later range (their slots are
     // the thread's, in the order of its rows; none on one thread).
     if (crossing) {
       for (std::uint32_t s = scratch.cross_begin[th]; s < scratch.cross_begin[th + 1]; ++s) {
         ForceScratch::CrossSlot& slot = scratch.cross[s];
-        evaluatePair<Law>(scratch.cross_ball[s], scratch.cross_pair[s], slot.fi, slot.ti, slot.fj, slot.tj, local);
+        const std::uint32_t i = scratch.cross_ball[s], k = scratch.cross_pair[s];
+        evaluatePair(i, position[i], radius[i], k, partner[k], slot.fi, slot.ti, slot.fj, slot.tj);
       }
 #pragma omp barrier
     }
@@ -179,18 +190,6 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
       scratch.acc_torque[q] = t;
     }
     // ...then every ball's own row (scattering to partners in the range) and walls.
-    // The touch test reads through local pointers with the row's ball in registers:
-    // through the members, every store into the history would make the compiler
-    // reload the arrays' addresses and the ball's position for the next pair, on the
-    // chain of loads each apart pair waits for.
-    const Vec3* const position = p.position.data();  // the fused kick writes it: not restrict
-    const double* __restrict const radius = p.radius.data();
-    const std::uint32_t* __restrict const partner = nb.pairs.partner.data();
-    // An apart pair's history cleared through locals too: a byte store may alias
-    // anything, so through the members each would reload the vectors' addresses.
-    std::uint8_t* const touched = history.pair_touch.data();
-    Vec3* const shear = history.pair_shear.data();
-    double* const relax_offset = relax.active() ? relax.pair.data() : nullptr;
     for (std::uint32_t i = b; i < e; ++i) {
       Vec3 f = scratch.acc_force[i], t = scratch.acc_torque[i];
       const Vec3 xi = position[i];
@@ -204,17 +203,8 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
           continue;
         }
         const std::uint32_t j = partner[k];
-        const double rj = radius[j];
-        const Vec3 d = position[j] - xi;
-        const double dist2 = d.squaredNorm();
-        if (ballsApart(dist2, ri, rj)) {  // as pairApart(k)
-          touched[k] = 0;
-          shear[k].setZero();
-          if (relax_offset) relax_offset[k] = 0.0;
-          continue;
-        }
         Vec3 fi, ti, fj, tj;
-        if (!evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, local)) continue;
+        if (!evaluatePair(i, xi, ri, k, j, fi, ti, fj, tj)) continue;
         f += fi;
         t += ti;
         scratch.acc_force[j] += fj;
