@@ -21,7 +21,6 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
   const std::size_t n = position.size();
   out.row_offset.assign(n + 1, 0);
   out.partner.clear();
-  out.col_pair.clear();
   if (n < 2) return;
 
   // Levels: level k holds radii in [r_min 2^k, r_min 2^(k+1)).
@@ -152,29 +151,13 @@ void NeighborFinder::build(std::span<const Vec3> position, std::span<const doubl
     keys_.resize(kept);
   }
 
-  // Rows by i (keys are sorted by (i, j)), then the transpose by j.
+  // Rows by i (keys are sorted by (i, j)).
   out.partner.resize(keys_.size());
   for (std::size_t p = 0; p < keys_.size(); ++p) {
     out.partner[p] = static_cast<std::uint32_t>(keys_[p] & 0xffffffffu);
     ++out.row_offset[(keys_[p] >> 32) + 1];
   }
   for (std::size_t i = 0; i < n; ++i) out.row_offset[i + 1] += out.row_offset[i];
-  if (nthreads == 1) {  // only the threads' hand-over reads the transpose (built when a team grows)
-    out.col_offset.clear();
-    out.col_pair.clear();
-    return;
-  }
-  out.buildTranspose();
-}
-
-void PairList::buildTranspose() {
-  const std::size_t n = row_offset.size() - 1;
-  col_offset.assign(n + 1, 0);
-  for (std::size_t p = 0; p < partner.size(); ++p) ++col_offset[partner[p] + 1];
-  for (std::size_t i = 0; i < n; ++i) col_offset[i + 1] += col_offset[i];
-  col_pair.resize(partner.size());
-  std::vector<std::uint32_t> fill(col_offset.begin(), col_offset.end() - 1);
-  for (std::size_t p = 0; p < partner.size(); ++p) col_pair[fill[partner[p]]++] = static_cast<std::uint32_t>(p);
 }
 
 }  // namespace rocklab::sim::detail

@@ -14,24 +14,13 @@ namespace rocklab::sim::detail {
 
 using geometry::Vec3;
 
-/// Pairs in compressed rows: row i lists partners j > i in ascending order.
-/// `col_*` is the transpose: for ball j, the indices of the pairs (i, j), i < j,
-/// in ascending i. Both orders are canonical, so sums over them are the same
-/// whatever the number of threads and whenever the list was rebuilt. The
-/// transpose is built only for more than one thread (empty otherwise).
+/// Pairs in compressed rows: row i lists partners j > i in ascending order. The
+/// order is canonical, so sums over it are the same whatever the number of
+/// threads and whenever the list was rebuilt.
 struct PairList {
   std::vector<std::uint32_t> row_offset;  // [n+1]
   std::vector<std::uint32_t> partner;     // [pairs] j of each pair
-  std::vector<std::uint32_t> col_offset;  // [n+1]
-  std::vector<std::uint32_t> col_pair;    // [pairs] pair index, grouped by j
   std::size_t size() const { return partner.size(); }
-  /// True when col_offset/col_pair are this list's transpose (built on two or more
-  /// threads, or by buildTranspose since).
-  bool hasTranspose() const { return !row_offset.empty() && col_offset.size() == row_offset.size(); }
-  /// The transpose (pairs grouped by j, ascending pair index within a group) that
-  /// the threads' hand-over reads: a list built on one thread has none, and a team
-  /// that grows before the next build needs it.
-  void buildTranspose();
 };
 
 class NeighborFinder {

@@ -244,12 +244,17 @@ struct World::Impl {
     struct CrossSlot {
       Vec3 fi, ti, fj, tj;  // N, N m on the first and the second ball
     };
-    static constexpr std::uint32_t kNotCross = 0xffffffffu;
     std::vector<std::uint32_t> range_begin;  // [team+1] balls of each thread
-    std::vector<std::uint32_t> cross_index;  // [pairs] slot of a pair crossing two ranges, or kNotCross
+    // Pairs (i, j) whose j lies in a later range than i: one slot each, in the
+    // order of i's rows (ascending i, then ascending j), so a thread meets its
+    // slots in its rows in slot order and needs no index per pair.
     std::vector<CrossSlot> cross;
     std::vector<std::uint32_t> cross_begin;  // [team+1] slots of each thread's phase A
     std::vector<std::uint32_t> cross_ball, cross_pair;  // [slots] first ball and pair of each slot
+    // The slots each range receives: (second ball, slot) in ascending second
+    // ball, then ascending first ball, grouped by the range of the second ball.
+    std::vector<std::uint32_t> receive_begin;  // [team+1]
+    std::vector<std::uint32_t> receive_ball, receive_slot;  // [slots]
     std::vector<Vec3> acc_force, acc_torque;  // [n] N, N m: contacts and contributions, no gravity
   } scratch;
 
@@ -303,11 +308,14 @@ struct World::Impl {
   } relax;
 
   // Below this many balls per thread a second thread does not pay: a step of a
-  // few thousand balls takes tens of microseconds, and waking the team, the
-  // barrier and the cross-range pairs cost as much (measured: the 1500-ball demo
-  // ran 1.65x slower on 2 threads, while 2000 lattice balls ran 1.7x faster, and
-  // 16000 balls 1.5-1.9x faster). Results are bitwise the same whatever the team.
-  static constexpr std::size_t kMinBallsPerThread = 2500;
+  // thousand balls takes tens of microseconds, and waking the team and the
+  // barrier cost as much. Since the second range receives its cross-range
+  // contributions from a list of its own (assignRanges) instead of scanning every
+  // ball's column, 2000 balls run 1.5-2.1x faster on two threads (session 32:
+  // the dense and settle benchmark scenes, three runs each); the adaptive team
+  // (team_tuner.h) still falls back to one thread where a step is too short.
+  // Results are bitwise the same whatever the team.
+  static constexpr std::size_t kMinBallsPerThread = 1000;
   int fullTeam() const {
     const auto useful = static_cast<int>(p.size() / kMinBallsPerThread);
     return std::max(1, std::min(threads, useful));
@@ -402,9 +410,6 @@ struct World::Impl {
   void updateRelaxation();
   // 3. forces (stages/forces.cpp: the contact law and the pass in one unit, so it inlines)
   void forceStage(const StepPlan& plan, StepChecks& checks);
-  template <class Law>
-  bool evaluateTouchingPair(std::size_t i, std::uint32_t j, std::uint32_t k, const Vec3& xi, double ri, double rj,
-                            const Vec3& d, double dist2, Vec3& fi, Vec3& ti, Vec3& fj, Vec3& tj, StepChecks& c);
   template <class Law> void addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c);
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
   // 4. bonds (stages/bonds.cpp; contact bonds in stages/contact_bonds.cpp)

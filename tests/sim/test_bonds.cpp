@@ -330,12 +330,14 @@ TEST_CASE("bond: a bonded chain's longest mode follows the chain's dispersion re
 namespace {
 
 /// Rows of bonded balls resting on a floor and pulled apart: bonds break, in
-/// order, on both halves of a two-thread team.
+/// order, on both halves of a two-thread team. `reach` > 1 also bonds each ball
+/// to the balls up to `reach` places further along its half of the row (strong
+/// bonds that hold): more bonds than balls.
 struct BreakingRows {
   sim::Model model;
   std::vector<sim::SphereSpec> spheres;
   std::vector<sim::BondSpec> bonds;
-  BreakingRows(int rows, int per_row) {
+  BreakingRows(int rows, int per_row, int reach = 1) {
     model = bondModel();
     model.gravity = Vec3(0, 0, -9.81);
     model.walls = {test::floorPlane(0.0)};
@@ -352,6 +354,10 @@ struct BreakingRows {
           bonds.push_back(bond(static_cast<std::uint32_t>(spheres.size() - 1),
                                static_cast<std::uint32_t>(spheres.size()), strength, strength));
         }
+        for (int back = 2; back <= reach && x - back >= 0; ++back)
+          if ((x - back < per_row / 2) == (x < per_row / 2))
+            bonds.push_back(bond(static_cast<std::uint32_t>(spheres.size() - back),
+                                 static_cast<std::uint32_t>(spheres.size()), 6e7, 6e7));
         spheres.push_back(
             test::sphere(Vec3(pitch * x, 3 * kRadius * y, kRadius), kRadius, Vec3(vx, 0, 0)));
       }
@@ -361,7 +367,7 @@ struct BreakingRows {
 }  // namespace
 
 TEST_CASE("bond: bitwise the same on one and two threads while bonds break", "[bonds]") {
-  const BreakingRows scene(60, 100);  // 6000 balls: two threads need > 5000
+  const BreakingRows scene(60, 100);  // 6000 balls: two threads need >= 2000
   const auto [one, broken_one, t1, b1] =
       test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
   const auto [two, broken_two, t2, b2] =
@@ -377,8 +383,10 @@ TEST_CASE("bond: bitwise the same on one and two threads while bonds break", "[b
 
 TEST_CASE("bond: a world too small for two threads runs its many bonds on two, bitwise the same",
           "[bonds]") {
-  // 4,500 balls (one thread: fewer than 5,000) and 4,455 bonds (two: 2,000 a thread).
-  const BreakingRows scene(45, 100);
+  // 1,900 balls (one thread: fewer than 2,000) and 5,491 bonds (two: 2,000 a thread).
+  const BreakingRows scene(19, 100, 3);
+  REQUIRE(scene.spheres.size() < 2000);
+  REQUIRE(scene.bonds.size() >= 4000);
   const auto one = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
   const auto two = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
   REQUIRE(one.bond_threads == 1);

@@ -251,7 +251,7 @@ struct GluedRows {
 
 TEST_CASE("contact bond: bitwise the same on one and two threads while contact bonds break",
           "[bonds]") {
-  const GluedRows scene(60, 100);  // 6000 balls: two threads need > 5000
+  const GluedRows scene(60, 100);  // 6000 balls: two threads need >= 2000
   const auto [one, broken_one, t1, b1] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 1);
   const auto [two, broken_two, t2, b2] = test::runWithBreaks(scene.model, scene.spheres, scene.bonds, 2);
   REQUIRE(t1 == 1);

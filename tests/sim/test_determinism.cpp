@@ -36,7 +36,7 @@ TEST_CASE("bitwise identical on 1 and 2 threads", "[determinism]") {
   const auto s = lattice(30, 20, 10);  // 6000 balls: enough for a 2-thread team
   std::uint64_t hash[2];
   // Two threads really run: the engine's team for this world has two members
-  // (6000 balls / 2500 per thread), and OpenMP grants a team of two here (the
+  // (6000 balls / 1000 per thread), and OpenMP grants a team of two here (the
   // engine's parallel regions ask for num_threads(team)); with one thread
   // (OMP_THREAD_LIMIT=1, a world too small) the equality below would prove nothing.
   int granted = 0;

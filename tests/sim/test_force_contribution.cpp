@@ -96,7 +96,7 @@ TEST_CASE("force contribution: two balls on a spring oscillate at omega = sqrt(2
 }
 
 TEST_CASE("force contribution: the extra-forces stage is bitwise the same on one and two threads", "[contribution]") {
-  // 6000 balls (two threads need > 5000), touching a floor and each other in rows, with
+  // 6000 balls (two threads need >= 2000), touching a floor and each other in rows, with
   // springs between neighbours of a row: contacts and contributions on the same balls.
   const double r = 0.001;
   sim::Model model = test::linearModel(1e5, 0.3, 0.1);

@@ -21,45 +21,73 @@ namespace rocklab::sim {
 // A ball is complete once its own row is done (later balls never read it in this
 // step), so it is integrated right there unless an observer needs the forces.
 
+namespace {
+
+// What the contact law reads at a ball pair, loaded once per pass into the
+// thread's registers and stack. Read through the World's members, every store
+// into the history (pair_touch is a byte, which may alias anything) made the
+// compiler reload each array's address and each constant for the next pair.
+struct PairLawInputs {
+  const Vec3* position;
+  const Vec3* velocity;
+  const Vec3* omega;
+  const double* mass;
+  const std::int32_t* material;
+  const detail::PairProps* props;  // [material a * materials + material b]
+  std::size_t materials;
+  std::uint8_t* touched;  // history.pair_touch
+  Vec3* shear;            // history.pair_shear
+  double* relax_offset;   // relax.pair while initial overlaps relax, else null
+  double relax_factor;
+  ContactModel contact;
+  double dt;
+  double max_overlap_fraction;  // the watchdog's
+  bool damped;
+};
+
 // Pair k = (i, j) whose test found them touching (d = xj - xi, dist2 = |d|^2): the
 // contact law; false when the relaxing initial overlap leaves no force.
 template <class Law>
-[[gnu::always_inline]] inline bool World::Impl::evaluateTouchingPair(std::size_t i, std::uint32_t j, std::uint32_t k,
-                                                                     const Vec3& xi, double ri, double rj, const Vec3& d,
-                                                                     double dist2, Vec3& fi, Vec3& ti, Vec3& fj,
-                                                                     Vec3& tj, StepChecks& c) {
-  const bool damped = model.contact.damping_normal > 0 || model.contact.damping_shear > 0;
+[[gnu::always_inline]] inline bool evaluateTouchingPair(const PairLawInputs& in, std::size_t i, std::uint32_t j,
+                                                        std::uint32_t k, const Vec3& xi, double ri, double rj,
+                                                        const Vec3& d, double dist2, Vec3& fi, Vec3& ti, Vec3& fj,
+                                                        Vec3& tj, StepChecks& c) {
   Vec3 n, cp;
   double overlap;
   touchingBallGeometry(xi, d, dist2, ri, rj, n, overlap, cp);
   detail::ContactGeometry g;
   g.normal = n;
   g.overlap = overlap;
-  if (relax.active()) {
-    // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
-    g.overlap = pairOverlap(overlap, k);
+  if (in.relax_offset) {
+    // Initial overlap being relaxed: the law sees only the overlap beyond the offset
+    // (World::Impl::pairOverlap).
+    g.overlap = overlap - in.relax_factor * in.relax_offset[k];
     if (g.overlap <= 0) {
-      history.pair_touch[k] = 0;
-      history.pair_shear[k].setZero();
+      in.touched[k] = 0;
+      in.shear[k].setZero();
       return false;
     }
   }
-  const Vec3 ai = cp - xi, aj = cp - p.position[j];
-  g.rel_velocity = (p.velocity[j] + p.omega[j].cross(aj)) - (p.velocity[i] + p.omega[i].cross(ai));
+  const Vec3 ai = cp - xi, aj = cp - in.position[j];
+  g.rel_velocity = (in.velocity[j] + in.omega[j].cross(aj)) - (in.velocity[i] + in.omega[i].cross(ai));
   g.r_tilde = effectiveRadius(ri, rj);  // Eq 2-24
   // Only the dashpots read it: a division per contact saved on undamped scenes.
-  g.damping_mass = damped ? detail::dampingMass(model.contact.damping_mass, p.mass[i], p.mass[j]) : 0.0;
-  const detail::ContactResult res = detail::evaluateContact<Law>(pairProps(i, j), model.contact, g, dt, history.pair_shear[k]);
+  g.damping_mass = in.damped ? detail::dampingMass(in.contact.damping_mass, in.mass[i], in.mass[j]) : 0.0;
+  const detail::PairProps& props =
+      in.props[static_cast<std::size_t>(in.material[i]) * in.materials + static_cast<std::size_t>(in.material[j])];
+  const detail::ContactResult res = detail::evaluateContact<Law>(props, in.contact, g, in.dt, in.shear[k]);
   fi = res.force;
   ti = ai.cross(res.force);
   fj = -res.force;
   tj = aj.cross(fj);
-  history.pair_touch[k] = 1;
+  in.touched[k] = 1;
   const double r_small = std::min(ri, rj);
-  if (g.overlap > model.watchdog.max_overlap_fraction * r_small)
+  if (g.overlap > in.max_overlap_fraction * r_small)
     mergeWorst(c, g.overlap / r_small, (std::uint64_t(i) << 32) | j);
   return true;
 }
+
+}  // namespace
 
 template <class Law>
 inline void World::Impl::addWallForces(std::size_t i, Vec3& f, Vec3& t, StepChecks& c) {
@@ -151,6 +179,23 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
     std::uint8_t* const touched = history.pair_touch.data();
     Vec3* const shear = history.pair_shear.data();
     double* const relax_offset = relax.active() ? relax.pair.data() : nullptr;
+    const PairLawInputs law_inputs{position,
+                                   p.velocity.data(),
+                                   p.omega.data(),
+                                   p.mass.data(),
+                                   p.material.data(),
+                                   ball_ball.data(),
+                                   nm,
+                                   touched,
+                                   shear,
+                                   relax_offset,
+                                   relax.factor,
+                                   model.contact,
+                                   dt,
+                                   model.watchdog.max_overlap_fraction,
+                                   model.contact.damping_normal > 0 || model.contact.damping_shear > 0};
+    Vec3* const acc_force = scratch.acc_force.data();
+    Vec3* const acc_torque = scratch.acc_torque.data();
     auto evaluatePair = [&](std::uint32_t i, const Vec3& xi, double ri, std::uint32_t k, std::uint32_t j, Vec3& fi,
                             Vec3& ti, Vec3& fj, Vec3& tj) __attribute__((always_inline)) {
       const double rj = radius[j];
@@ -162,7 +207,7 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
         if (relax_offset) relax_offset[k] = 0.0;  // separated: a new touch gets the full force
         return false;
       }
-      return evaluateTouchingPair<Law>(i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, local);
+      return evaluateTouchingPair<Law>(law_inputs, i, j, k, xi, ri, rj, d, dist2, fi, ti, fj, tj, local);
     };
     // Phase A: pairs whose second ball belongs to a later range (their slots are
     // the thread's, in the order of its rows; none on one thread).
@@ -175,47 +220,49 @@ void World::Impl::forcePass(bool integrate_now, double h, StepChecks& merged) {
 #pragma omp barrier
     }
     // Phase B: start every ball of the range with the cross contributions it
-    // receives (pairs (i', p), i' < b, ascending i').
+    // receives (pairs (i', q), i' < b, ascending i'); none on one thread.
     for (std::uint32_t q = b; q < e; ++q) {
-      Vec3 f = Vec3::Zero(), t = Vec3::Zero();
-      if (b > 0)  // the first range receives none (and one thread has no transpose)
-        for (std::uint32_t c = nb.pairs.col_offset[q]; c < nb.pairs.col_offset[q + 1]; ++c) {
-          const std::uint32_t k = nb.pairs.col_pair[c];
-          if (scratch.cross_index[k] == ForceScratch::kNotCross) break;  // the rest come from this range
-          if (!history.pair_touch[k]) continue;
-          f += scratch.cross[scratch.cross_index[k]].fj;
-          t += scratch.cross[scratch.cross_index[k]].tj;
-        }
-      scratch.acc_force[q] = f;
-      scratch.acc_torque[q] = t;
+      acc_force[q].setZero();
+      acc_torque[q].setZero();
     }
+    if (crossing)
+      for (std::uint32_t r = scratch.receive_begin[th]; r < scratch.receive_begin[th + 1]; ++r) {
+        const std::uint32_t s = scratch.receive_slot[r];
+        if (!touched[scratch.cross_pair[s]]) continue;
+        const std::uint32_t q = scratch.receive_ball[r];
+        acc_force[q] += scratch.cross[s].fj;
+        acc_torque[q] += scratch.cross[s].tj;
+      }
     // ...then every ball's own row (scattering to partners in the range) and walls.
+    // A partner past the range is a cross pair, met in slot order (assignRanges).
+    std::uint32_t next_slot = crossing ? scratch.cross_begin[th] : 0;
     for (std::uint32_t i = b; i < e; ++i) {
-      Vec3 f = scratch.acc_force[i], t = scratch.acc_torque[i];
+      Vec3 f = acc_force[i], t = acc_torque[i];
       const Vec3 xi = position[i];
       const double ri = radius[i];
       const std::uint32_t row_end = nb.pairs.row_offset[i + 1];
       for (std::uint32_t k = nb.pairs.row_offset[i]; k < row_end; ++k) {
-        if (crossing && scratch.cross_index[k] != ForceScratch::kNotCross) {
-          if (!history.pair_touch[k]) continue;
-          f += scratch.cross[scratch.cross_index[k]].fi;
-          t += scratch.cross[scratch.cross_index[k]].ti;
+        const std::uint32_t j = partner[k];
+        if (j >= e) {  // never on one thread (e = n)
+          const std::uint32_t s = next_slot++;
+          if (!touched[k]) continue;
+          f += scratch.cross[s].fi;
+          t += scratch.cross[s].ti;
           continue;
         }
-        const std::uint32_t j = partner[k];
         Vec3 fi, ti, fj, tj;
         if (!evaluatePair(i, xi, ri, k, j, fi, ti, fj, tj)) continue;
         f += fi;
         t += ti;
-        scratch.acc_force[j] += fj;
-        scratch.acc_torque[j] += tj;
+        acc_force[j] += fj;
+        acc_torque[j] += tj;
       }
       addWallForces<Law>(i, f, t, local);
       if (integrate_now && !(clump_of && clump_of[i] >= 0)) {
         integrate(i, f, t, h, local);
       } else {
-        scratch.acc_force[i] = f;
-        scratch.acc_torque[i] = t;
+        acc_force[i] = f;
+        acc_torque[i] = t;
       }
     }
 #pragma omp critical

@@ -106,33 +106,46 @@ void World::Impl::assignRanges() {
   const int team = teamSize();
   scratch.range_begin.resize(static_cast<std::size_t>(team) + 1);
   for (int t = 0; t <= team; ++t) scratch.range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
-  // One thread has no pair crossing two ranges: no slot index (4 bytes a pair).
-  if (team == 1) {
-    for (auto* v : {&scratch.cross_index, &scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair}) {
-      v->clear();
+  for (auto* v : {&scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair, &scratch.receive_begin,
+                  &scratch.receive_ball, &scratch.receive_slot})
+    v->clear();
+  if (team == 1) {  // one thread: no pair crosses two ranges
+    for (auto* v : {&scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair, &scratch.receive_begin,
+                    &scratch.receive_ball, &scratch.receive_slot})
       v->shrink_to_fit();
-    }
     scratch.cross.clear();
     return;
   }
-  // A list built on one thread has no transpose; the team grew since (the adaptive
-  // team, or the policy): without it the hand-over would lose the pairs across ranges.
-  if (!nb.pairs.hasTranspose()) nb.pairs.buildTranspose();
-  scratch.cross_index.assign(nb.pairs.size(), ForceScratch::kNotCross);
-  scratch.cross_begin.assign(1, 0);
-  scratch.cross_ball.clear();
-  scratch.cross_pair.clear();
+  scratch.cross_begin.push_back(0);
   for (int t = 0; t < team; ++t) {
     for (std::uint32_t i = scratch.range_begin[t]; i < scratch.range_begin[t + 1]; ++i)
       for (std::uint32_t k = nb.pairs.row_offset[i]; k < nb.pairs.row_offset[i + 1]; ++k)
         if (nb.pairs.partner[k] >= scratch.range_begin[t + 1]) {
-          scratch.cross_index[k] = static_cast<std::uint32_t>(scratch.cross_pair.size());
           scratch.cross_ball.push_back(i);
           scratch.cross_pair.push_back(k);
         }
     scratch.cross_begin.push_back(static_cast<std::uint32_t>(scratch.cross_pair.size()));
   }
-  scratch.cross.resize(scratch.cross_pair.size());
+  const std::size_t slots = scratch.cross_pair.size();
+  scratch.cross.resize(slots);
+  // Receivers: the slots sorted by second ball; the stable sort keeps ascending
+  // first ball within one (the slots are in ascending first ball), the order in
+  // which a ball sums what it receives on any number of threads.
+  std::vector<std::uint32_t> order(slots);
+  for (std::uint32_t s = 0; s < slots; ++s) order[s] = s;
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return nb.pairs.partner[scratch.cross_pair[a]] < nb.pairs.partner[scratch.cross_pair[b]];
+  });
+  scratch.receive_ball.resize(slots);
+  scratch.receive_slot = std::move(order);
+  scratch.receive_begin.assign(static_cast<std::size_t>(team) + 1, 0);
+  int range = 0;
+  for (std::size_t r = 0; r < slots; ++r) {
+    const std::uint32_t j = nb.pairs.partner[scratch.cross_pair[scratch.receive_slot[r]]];
+    scratch.receive_ball[r] = j;
+    while (j >= scratch.range_begin[range + 1]) scratch.receive_begin[++range] = static_cast<std::uint32_t>(r);
+  }
+  while (range < team) scratch.receive_begin[++range] = static_cast<std::uint32_t>(slots);
 }
 
 }  // namespace rocklab::sim
