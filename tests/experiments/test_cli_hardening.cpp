@@ -263,6 +263,21 @@ TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C and a second signal kills",
   }
 }
 
+TEST_CASE("a run started with SIGHUP ignored (nohup) outlives a hang-up", "[cli]") {
+  const fs::path out = tempDir("nohup");
+  const auto before = std::signal(SIGHUP, SIG_IGN);  // as nohup starts it
+  std::thread sender([&out] {
+    waitUntilRunning(out);
+    std::raise(SIGHUP);  // the terminal closing
+  });
+  const int code = cli({"run", kHopper, "--out", out.string(), "--quiet", "--set", "scene.end_time=0.05"});
+  sender.join();
+  CHECK(std::signal(SIGHUP, before) == SIG_IGN);  // still ignored after the command
+  CHECK(code == 0);
+  CHECK(json::parse(slurp(out / "results.json"))["status"] != "interrupted");
+  fs::remove_all(out);
+}
+
 TEST_CASE("a tool that misses what was asked says why and exits 1", "[cli][shape]") {
   // calibrate: a target outside the values tried has no estimate.
   const fs::path cal = tempDir("calibrate");

@@ -77,21 +77,30 @@ core (--jobs N; --jobs 0 runs them here one after the other with --threads).
 Units are SI everywhere (m, s, kg, N, Pa).)";
 
 // The signals that ask a run to stop cleanly: Ctrl-C, and SIGTERM and SIGHUP, which
-// schedulers (Slurm at its time limit) and closed terminals send.
+// schedulers (Slurm at its time limit) and closed terminals send. A signal the
+// process was started ignoring stays ignored: `nohup rocklab run ...` must outlive
+// its terminal (rocklab's own handler used to turn the hang-up into a stop).
 constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+volatile std::sig_atomic_t g_stop_signal_handled[std::size(kStopSignals)] = {};
 
 extern "C" void onStopSignal(int) {
   requestStop();
-  // A second stop signal, of any of the three kinds, ends the process at once.
-  for (const int s : kStopSignals) std::signal(s, SIG_DFL);
+  // A second stop signal, of any of the handled kinds, ends the process at once.
+  for (std::size_t k = 0; k < std::size(kStopSignals); ++k)
+    if (g_stop_signal_handled[k]) std::signal(kStopSignals[k], SIG_DFL);
 }
 
 /// While alive, SIGINT, SIGTERM and SIGHUP request a clean stop (checkpoint, results.json
-/// with status "interrupted", exit 130); the handlers before it come back afterwards.
+/// with status "interrupted", exit 130), but for those the process ignores; the
+/// handlers before it come back afterwards.
 class StopOnSignals {
  public:
   StopOnSignals() {
-    for (std::size_t k = 0; k < std::size(kStopSignals); ++k) previous_[k] = std::signal(kStopSignals[k], onStopSignal);
+    for (std::size_t k = 0; k < std::size(kStopSignals); ++k) {
+      previous_[k] = std::signal(kStopSignals[k], onStopSignal);
+      g_stop_signal_handled[k] = previous_[k] != SIG_IGN;
+      if (previous_[k] == SIG_IGN) std::signal(kStopSignals[k], SIG_IGN);
+    }
   }
   ~StopOnSignals() {
     for (std::size_t k = 0; k < std::size(kStopSignals); ++k) std::signal(kStopSignals[k], previous_[k]);
