@@ -73,6 +73,7 @@ TEST_CASE("calibrate: finds the damping ratio for a target restitution", "[exper
   CalibrateOptions c;
   c.sweep.scene = kAssets + "drop.toml";
   c.sweep.vary = {parseVary("contact.damping_normal=0.05,0.1,0.15")};
+  c.sweep.overrides = {"contact.damping_shear=0.2"};  // the check it suggests must carry it
   c.sweep.out_dir = fs::temp_directory_path() / "rocklab-exp-calibrate";
   c.sweep.progress = false;
   c.target_metric = "restitution";
@@ -87,6 +88,8 @@ TEST_CASE("calibrate: finds the damping ratio for a target restitution", "[exper
   CHECK(r["estimate"].get<double>() == Approx(rocklab::sim::dampingFromRestitution(0.72)).margin(0.008));
   CHECK(fs::exists(c.sweep.out_dir / "calibration.csv"));
   CHECK(log.str().find("contact.damping_normal = 0.0") != std::string::npos);
+  // The suggested check runs the scene as calibrated: its overrides, then the estimate.
+  CHECK(log.str().find(" --set contact.damping_shear=0.2 --set contact.damping_normal=0.") != std::string::npos);
 }
 
 TEST_CASE("heap: a small heap of clumps stands at a non-zero angle", "[experiment]") {

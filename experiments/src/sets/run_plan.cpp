@@ -32,9 +32,7 @@ namespace rocklab::experiments::detail {
 using json = nlohmann::json;
 namespace fs = std::filesystem;
 
-namespace {
-
-/// Quoted for POSIX sh: 'it'\''s'.
+// Quoted for POSIX sh (run_plan.h): 'it'\''s'.
 std::string shellQuote(const std::string& s) {
   // A word of these characters means the same to the shell bare: the line stays readable.
   const bool plain = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
@@ -45,6 +43,9 @@ std::string shellQuote(const std::string& s) {
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
 }
+
+namespace {
+
 
 /// key=value with characters a file name can carry; the rest become '_'.
 std::string folderName(const SweepOptions& o, const std::vector<std::string>& values) {

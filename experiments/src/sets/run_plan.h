@@ -63,4 +63,7 @@ std::vector<Variant> inspectRuns(const std::filesystem::path& set_dir, const std
 /// The number of processes for --jobs when not given: the cores.
 int defaultJobs();
 
+/// `s` as one word for POSIX sh: bare when that means the same, else in single quotes.
+std::string shellQuote(const std::string& s);
+
 }  // namespace rocklab::experiments::detail

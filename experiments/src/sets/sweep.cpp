@@ -322,7 +322,10 @@ int runCalibrate(const CalibrateOptions& c, std::ostream& log) {
     return kExitFailed;
   }
   log << "calibrate: " << key << " = " << cell(estimate) << " gives " << c.target_metric << " = " << c.target << " ("
-      << how << ")\n  check it: rocklab " << (restartsFrom(o.scene) ? "restart " : "run ") << o.scene << " --set " << key << "=" << cell(estimate) << "\n";
+      << how << ")\n  check it: rocklab " << (restartsFrom(o.scene) ? "restart " : "run ") << detail::shellQuote(o.scene);
+  // The overrides every run had, then the estimate: the check runs the same scene.
+  for (const std::string& a : o.overrides) log << " --set " << detail::shellQuote(a);
+  log << " --set " << key << "=" << cell(estimate) << "\n";
   return kExitOk;
 }
 
