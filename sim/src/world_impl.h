@@ -82,6 +82,10 @@ struct ContactPoint {
   point = xi + normal * (ri - 0.5 * overlap);
 }
 
+/// The overlap the contact law sees while an initial overlap `offset` relaxes
+/// (Model::relaxation): the part beyond `factor` times the offset.
+inline double relaxedOverlap(double overlap, double factor, double offset) { return overlap - factor * offset; }
+
 /// Whether balls i and j are apart, from d = xj - xi and their radii.
 [[gnu::always_inline]] inline bool ballsApart(double dist2, double ri, double rj) {
   const double rsum = ri + rj;
@@ -349,12 +353,11 @@ struct World::Impl {
     return ball_wall[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(model.walls[wall].material)];
   }
   /// The overlap the contact law sees while initial overlaps relax (Model::relaxation).
-  double pairOverlap(double overlap, std::uint32_t k) const {
-    return relax.active() ? overlap - relax.factor * relax.pair[k] : overlap;
+  double pairOverlap(const ContactPoint& g, std::uint32_t k) const {
+    return relax.active() ? relaxedOverlap(g.overlap, relax.factor, relax.pair[k]) : g.overlap;
   }
-  double pairOverlap(const ContactPoint& g, std::uint32_t k) const { return pairOverlap(g.overlap, k); }
   double wallOverlap(const ContactPoint& g, std::uint32_t c) const {
-    return relax.active() ? g.overlap - relax.factor * relax.wall[c] : g.overlap;
+    return relax.active() ? relaxedOverlap(g.overlap, relax.factor, relax.wall[c]) : g.overlap;
   }
   /// The contacts of ball i with the wall of candidate c (the first of its
   /// slots), with the walls' poses of `runtime`. A mesh wall's touches go into

@@ -46,7 +46,6 @@ std::string shellQuote(const std::string& s) {
 
 namespace {
 
-
 /// key=value with characters a file name can carry; the rest become '_'.
 std::string folderName(const SweepOptions& o, const std::vector<std::string>& values) {
   std::string name;

@@ -59,9 +59,8 @@ template <class Law>
   g.normal = n;
   g.overlap = overlap;
   if (in.relax_offset) {
-    // Initial overlap being relaxed: the law sees only the overlap beyond the offset
-    // (World::Impl::pairOverlap).
-    g.overlap = overlap - in.relax_factor * in.relax_offset[k];
+    // Initial overlap being relaxed: the law sees only the overlap beyond the offset.
+    g.overlap = relaxedOverlap(overlap, in.relax_factor, in.relax_offset[k]);
     if (g.overlap <= 0) {
       in.touched[k] = 0;
       in.shear[k].setZero();

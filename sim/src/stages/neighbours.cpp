@@ -106,13 +106,11 @@ void World::Impl::assignRanges() {
   const int team = teamSize();
   scratch.range_begin.resize(static_cast<std::size_t>(team) + 1);
   for (int t = 0; t <= team; ++t) scratch.range_begin[t] = static_cast<std::uint32_t>(n * static_cast<std::size_t>(t) / team);
-  for (auto* v : {&scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair, &scratch.receive_begin,
-                  &scratch.receive_ball, &scratch.receive_slot})
-    v->clear();
+  const auto lists = {&scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair,
+                      &scratch.receive_begin, &scratch.receive_ball, &scratch.receive_slot};
+  for (auto* v : lists) v->clear();
   if (team == 1) {  // one thread: no pair crosses two ranges
-    for (auto* v : {&scratch.cross_begin, &scratch.cross_ball, &scratch.cross_pair, &scratch.receive_begin,
-                    &scratch.receive_ball, &scratch.receive_slot})
-      v->shrink_to_fit();
+    for (auto* v : lists) v->shrink_to_fit();
     scratch.cross.clear();
     return;
   }
