@@ -393,6 +393,61 @@ TEST_CASE("samples.png leaves out a group in which no sample has the figure (eve
   fs::remove_all(dir);
 }
 
+TEST_CASE("sweeps: two sweeps of one key side by side, each row's x over its own --x-over figure", "[plan]") {
+  // As the zoned chute's single-size CSS sweeps, one deposit (so one sweep) a clump size, are
+  // plotted against CSS / d_eq: the divisor differs between the sweeps. Stand-in runs:
+  //   "small": contact time 0.01 s; damping 0.1 gives 0.7, at 0.2 no figure (a jammed case)
+  //   "large": contact time 0.02 s; damping 0.1 gives 0.6, 0.2 gives 0.5
+  const fs::path dir = fresh("sweeps");
+  const char* figure[2][2] = {{"0.7", ""}, {"0.6", "0.5"}};
+  for (int s = 0; s < 2; ++s) {
+    const fs::path set = dir / (s ? "large" : "small");
+    REQUIRE(cli({"sweep", "drop", "--vary", "contact.damping_normal=0.2,0.1", "--metric", "restitution", "--x-over",
+                 "drop.contact_time_s", "--plan", set.string()}) == 0);
+    for (int v = 0; v < 2; ++v) {
+      const fs::path run = set / "runs" / (std::string("contact.damping_normal=") + (v ? "0.2" : "0.1"));
+      fs::create_directories(run);
+      std::ofstream(run / "results.json")
+          << "{\"status\": \"completed\", \"drop\": {\"contact_time_s\": " << (s ? 0.02 : 0.01) << "}"
+          << (*figure[s][v] ? std::string(", \"restitution\": ") + figure[s][v] : "") << "}";
+    }
+    REQUIRE(cli({"collect", set.string()}) == 0);
+  }
+  const fs::path out = dir / "both";
+  REQUIRE(cli({"sweeps", (dir / "small").string(), (dir / "large").string(), "--out", out.string()}) == 0);
+  const auto table = lines(out / "sweeps.csv");
+  REQUIRE(table.size() == 5);  // a row a run, each sweep's rows by x
+  CHECK(table[0] == "sweep,contact.damping_normal,restitution,drop.contact_time_s,status,"
+                    "contact.damping_normal / drop.contact_time_s");
+  CHECK(table[1] == "small,0.1,0.7,0.01,ok,10");
+  CHECK(table[2] == "small,0.2,,0.01,ok,20");
+  CHECK(table[3] == "large,0.1,0.6,0.02,ok,5");
+  CHECK(table[4] == "large,0.2,0.5,0.02,ok,10");
+  const std::string plotted = rocklab::experiments::test::slurp(out / "sweeps.plot.csv");
+  CHECK(plotted.find("contact.damping_normal / drop.contact_time_s,restitution") != std::string::npos);
+  CHECK(plotted.find("large,10,0.5") != std::string::npos);
+  CHECK(plotted.find("small,20,nan") != std::string::npos);  // no figure: not drawn, the line breaks
+  const nlohmann::json j = nlohmann::json::parse(rocklab::experiments::test::slurp(out / "sweeps.json"));
+  CHECK(j["figure"] == "restitution");
+  CHECK(j["sweeps"][1]["label"] == "large");
+  CHECK(j["sweeps"][0]["rows"][1]["y"].is_null());
+  // Bad input: exit 2, nothing written, the message says what is allowed.
+  const fs::path nothing = dir / "nothing";
+  std::string log;
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"sweeps", (dir / "small").string(), "--figure", "status", "--out", nothing.string()}, log) == 2);
+  CHECK(log.find("allowed: drop.contact_time_s, restitution") != std::string::npos);
+  REQUIRE(cli({"sweep", "drop", "--vary", "contact.damping_normal=0.1", "--metric", "restitution", "--plan",
+               (dir / "plain").string()}) == 0);
+  std::ofstream((dir / "plain" / "sweep.csv")) << "contact.damping_normal,restitution,status\n0.1,0.7,ok\n";
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"sweeps", (dir / "small").string(), (dir / "plain").string(), "--out", nothing.string()}, log) == 2);
+  CHECK(log.find("allowed: sweeps") != std::string::npos);
+  CHECK(cli({"sweeps", (dir / "small").string(), "--label", "a", "--label", "b", "--out", nothing.string()}) == 2);
+  CHECK_FALSE(fs::exists(nothing));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("a stop signal to a sweep reaches its runs: each stops cleanly and says so", "[plan][cli]") {
   // Slurm's SIGTERM or a `kill` reaches the sweep's process only (its runs are process
   // groups of their own); it passes the stop on, so no run goes on orphaned.

@@ -6,12 +6,12 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include "analysis/plot.h"
 #include "analysis/sample_statistics.h"
+#include "analysis/sweep_sets.h"
 #include "analysis/sweep_table.h"
 #include "common/atomic_file.h"
 #include "common/csv.h"
@@ -19,7 +19,6 @@
 #include "common/json_text.h"
 #include "rocklab/experiments/run.h"
 #include "scene/scene_keys.h"
-#include "sets/plan_file.h"
 #include "sets/run_set.h"
 
 namespace rocklab::experiments {
@@ -28,77 +27,9 @@ namespace {
 
 using json = nlohmann::json;
 
-struct SamplesInputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-/// One sample: a finished sweep's varied keys and table (its runs that ended normally).
-struct SampleSet {
-  std::string label;
-  std::filesystem::path dir;
-  std::vector<std::string> keys;  // the plan's order
-  std::string x_over;             // the sweep's --x-over ("" none): its plot's x is the first key over it
-  SweepTable table;
-};
-
-SampleSet readSet(const std::filesystem::path& dir) {
-  SampleSet set;
-  set.dir = dir;
-  detail::PlanFile plan;
-  try {
-    plan = detail::readPlanFile(dir);
-  } catch (const detail::PlanFileError& e) {
-    throw SamplesInputError(e.what());
-  }
-  if (plan.kind != "sweep")
-    throw SamplesInputError((dir / "plan.json").string() + ": kind \"" + plan.kind +
-                            "\" (allowed: \"sweep\"; a study merges its seeds itself, `rocklab study --seeds`)");
-  for (const auto& [key, values] : plan.options.vary) set.keys.push_back(key);
-  set.x_over = plan.options.x_over;
-  try {
-    set.table = readCsvTable(dir / "sweep.csv", " (a finished sweep's folder holds it; `rocklab collect " +
-                                                    dir.string() + "` writes it from the runs)");
-    for (const std::string& key : set.keys) set.table.column(key);
-  } catch (const std::invalid_argument& e) {
-    throw SamplesInputError(e.what());
-  }
-  return set;
-}
-
-/// The columns of a table that are figures: neither a varied key nor the status.
-std::vector<std::string> figureColumns(const SampleSet& s) {
-  std::vector<std::string> figures;
-  for (const std::string& h : s.table.header)
-    if (h != "status" && std::find(s.keys.begin(), s.keys.end(), h) == s.keys.end()) figures.push_back(h);
-  return figures;
-}
-
-std::string joined(std::vector<std::string> names) {
-  std::sort(names.begin(), names.end());
-  return names.empty() ? "none" : detail::joinedText(names);
-}
-
-/// The sets must vary the same keys and tabulate the same figures (in any order).
-void checkSameShape(const std::vector<SampleSet>& sets) {
-  const SampleSet& first = sets.front();
-  const std::set<std::string> keys(first.keys.begin(), first.keys.end());
-  const std::vector<std::string> first_figures = figureColumns(first);
-  const std::set<std::string> figures(first_figures.begin(), first_figures.end());
-  for (const SampleSet& s : sets) {
-    if (std::set<std::string>(s.keys.begin(), s.keys.end()) != keys)
-      throw SamplesInputError((s.dir / "plan.json").string() + ": varies " + joined(s.keys) + ", " +
-                              (first.dir / "plan.json").string() + " varies " + joined(first.keys) +
-                              " (allowed: sweeps of the same keys, one a sample)");
-    const std::vector<std::string> own = figureColumns(s);
-    if (std::set<std::string>(own.begin(), own.end()) != figures)
-      throw SamplesInputError(s.table.file.string() + ": figures " + joined(own) + ", " + first.table.file.string() +
-                              " has " + joined(first_figures) + " (allowed: sweeps with the same --metric figures)");
-    if (s.x_over != first.x_over || (!s.x_over.empty() && s.keys.front() != first.keys.front()))
-      throw SamplesInputError((s.dir / "plan.json").string() + ": --x-over \"" + s.x_over + "\" of " + s.keys.front() +
-                              ", " + (first.dir / "plan.json").string() + " \"" + first.x_over + "\" of " +
-                              first.keys.front() + " (allowed: sweeps plotted against the same x)");
-  }
-}
+using detail::figureColumns;
+using SampleSet = detail::SweepSet;  // a sweep a sample (or, with `over`, several)
+using SamplesInputError = detail::SweepSetError;
 
 enum class FigureKind { Number, Flag, Text };
 
@@ -362,14 +293,14 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
   std::optional<std::size_t> figure;
   try {
     for (std::size_t k = 0; k < o.runs.size(); ++k) {
-      sets.push_back(readSet(o.runs[k]));
+      sets.push_back(detail::readSweepSet(o.runs[k]));
       sets.back().label = detail::runLabel(o.runs, o.labels, k);
     }
-    checkSameShape(sets);
+    detail::checkSameShape(sets, "one a sample");
     const std::vector<std::string>& keys = sets.front().keys;
     if (!over.empty() && std::find(keys.begin(), keys.end(), over) == keys.end())
       throw SamplesInputError("--over " + over + ": not a key " + (sets.front().dir / "plan.json").string() +
-                              " varies (allowed: " + joined(keys) + ")");
+                              " varies (allowed: " + detail::sortedNames(keys) + ")");
     m = merge(sets, over);
     for (std::size_t f = 0; f < m.figures.size(); ++f) {
       const bool any = std::any_of(m.cells[f].begin(), m.cells[f].end(), [](const auto& variant) {
@@ -385,7 +316,7 @@ int runSamplesCommand(const RunComparisonOptions& o, const std::string& figure_n
                                 std::vector<std::string> allowed;
                                 for (std::size_t f = 0; f < m.figures.size(); ++f)
                                   if (m.kinds[f] == FigureKind::Number) allowed.push_back(m.figures[f]);
-                                return joined(allowed);
+                                return detail::sortedNames(allowed);
                               }() + ")");
   } catch (const SamplesInputError& e) {
     err << "error: samples: " << e.what() << '\n';

@@ -19,6 +19,7 @@
 #include "crusher/products_command.h"
 #include "analysis/profiles_command.h"
 #include "analysis/samples_command.h"
+#include "analysis/sweeps_command.h"
 #include "crusher/whiten_command.h"
 #include "report/run_report.h"
 #include "camera/render_run.h"
@@ -65,6 +66,7 @@ Examples:
   rocklab profiles runs/inclined runs/vertical --out out/deposition   # chute marker profiles side by side
   rocklab samples runs/lab-s1 runs/lab-s2 runs/lab-s3 --out runs/lab   # a sweep's mean and scatter over samples
   rocklab samples runs/chute --over scene.seed   # the same over the seeds one sweep varies
+  rocklab sweeps runs/css-large runs/css-medium --label "14.7 mm" --label "12.8 mm" --out runs/css-sizes   # sweeps as series
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
 missed what was asked (the reason in its results.json / calibration.json) or an
@@ -260,7 +262,7 @@ void addSweepOptions(CLI::App* c, CliArgs& a) {
 }
 
 /// A command that sets finished runs or sets side by side (products, profiles,
-/// samples): the folders, a legend label a folder, the output folder (default out/NAME).
+/// samples, sweeps): the folders, a legend label a folder, the output folder (default out/NAME).
 CLI::App* addRunComparison(CLI::App& app, CliArgs& a, const std::string& name, const std::string& what,
                            const std::string& folders, const std::string& outputs) {
   auto* c = app.add_subcommand(name, what);
@@ -323,6 +325,13 @@ void addCommands(CLI::App& app, CliArgs& a) {
                       "The sweep.csv column to plot and print (default: the first with numbers)");
   samples->add_option("--over", a.group_by,
                       "A key the sweeps vary whose values are samples (e.g. scene.seed; default: a sample a folder)");
+  auto* sweeps = addRunComparison(
+      app, a, "sweeps",
+      "Finished sweeps of the same keys side by side, a series each (e.g. one deposit a clump size): their rows in "
+      "one table and one figure against the first key (over each row's --x-over figure)",
+      "Folders of finished sweeps, one a series (their plan.json and sweep.csv)",
+      "sweeps.csv, sweeps.json and sweeps.png");
+  sweeps->add_option("--figure", a.figure, "The sweep.csv column to plot (default: the first with numbers)");
   auto* keys = app.add_subcommand("scene-keys", "Print the scene file reference (every table and key) as Markdown");
   keys->add_option("--check", a.collect_dir, "Compare with this file instead of printing (exit 1 if it differs)");
   auto* render = app.add_subcommand("render", "Re-render the frames stored in a run.h5 (scene cameras or --camera file)");
@@ -598,11 +607,12 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     a.whiten.out_dir = a.out_dir;
     return runWhitenCommand(a.whiten, std::cout, std::cerr);
   }
-  for (const std::string command : {"products", "profiles", "samples"}) {
+  for (const std::string command : {"products", "profiles", "samples", "sweeps"}) {
     if (!app.got_subcommand(command)) continue;
     a.comparison.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / command : std::filesystem::path(a.out_dir);
     if (command == "products") return runProductsCommand(a.comparison, std::cout, std::cerr);
     if (command == "profiles") return runProfilesCommand(a.comparison, std::cout, std::cerr);
+    if (command == "sweeps") return runSweepsCommand(a.comparison, a.figure, std::cout, std::cerr);
     return runSamplesCommand(a.comparison, a.figure, a.group_by, std::cout, std::cerr);
   }
   if (app.got_subcommand("collect")) return collectSet(a.collect_dir, std::cerr);

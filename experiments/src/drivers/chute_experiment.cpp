@@ -885,9 +885,12 @@ void ChuteExperiment::report(nlohmann::json& r, const std::filesystem::path& out
     writePlot(dis, out_dir / "discharge.png");
   }
 
-  log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit "
-      << (settle_.settled() ? "settled" : "NOT settled") << " at t = " << deposit_time_
-      << " s, bed " << bed_height_ * 1e3 << " mm, " << bodies_total_ << " bodies";
+  log << std::setprecision(4) << "chute " << e_.inclination_deg << " deg: deposit ";
+  if (std::isnan(deposit_time_))  // the run ended inside the deposit
+    log << "unfinished (the run ended during it), " << bodies_total_ << " bodies";
+  else
+    log << (settle_.settled() ? "settled" : "NOT settled") << " at t = " << deposit_time_ << " s, bed "
+        << bed_height_ * 1e3 << " mm, " << bodies_total_ << " bodies";
   if (removed_by_top_) log << " (" << removed_by_top_ << " bodies cut by the top plate removed)";
   log << "\n";
   if (stoppedAfterDeposit()) {
