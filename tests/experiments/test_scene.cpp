@@ -195,6 +195,15 @@ triangles = [[0, 1, 2]]
   CHECK(s.model.walls[0].mesh.vertices.size() == 4);  // welded
   CHECK(s.model.walls[0].mesh.bounds().hi.x() == Approx(1.0));
   CHECK(s.model.walls[1].mesh.triangleCount() == 1);
+  // `offset` moves a mesh after its scale: the file's floor (mm) 0.25 m up and 1 m along x.
+  const Scene moved = loadSceneText(kMinimal + walls, "mesh.toml", {"walls.0.offset=[1.0, 0, 0.25]"}, dir);
+  CHECK(moved.model.walls[0].mesh.bounds().lo.x() == Approx(1.0));
+  CHECK(moved.model.walls[0].mesh.bounds().hi.x() == Approx(2.0));
+  CHECK(moved.model.walls[0].mesh.bounds().lo.z() == Approx(0.25));
+  CHECK(moved.model.walls[1].mesh.bounds().lo.z() == Approx(1.0));  // the other mesh stays
+  CHECK_THAT(errorOf(kMinimal + "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nvertices = [[0, 0, 1], [1, 0, 1], "
+                                "[0, 1, 1]]\ntriangles = [[0, 1, 2]]\noffset = [1, 2]\n"),
+             Contains("key 'walls.0.offset' = [1, 2]: expected an array of 3 finite numbers"));
   CHECK_THAT(errorOf(kMinimal +
                      "\n[[walls]]\ntype = \"mesh\"\nmaterial = \"rock\"\nfile = \"missing.stl\"\n"),
              Contains("key 'walls.0.file' = \"missing.stl\": cannot read mesh"));

@@ -140,6 +140,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"walls", "angle_deg", "deg", "(plate) Angle of the length side above the x axis."},
       {"walls", "file", "", "(mesh) STL, PLY or OBJ file, relative to the scene file."},
       {"walls", "scale", "", "(mesh) Factor on the coordinates (0.001 for a file in mm)."},
+      {"walls", "offset", "m", "(mesh) Added to every vertex after the scale: places a file's part in the scene, or moves a mesh with one key (the heap funnel's height)."},
       {"walls", "triangles", "", "(mesh) Triangles as vertex indices [[i, j, k], ...] (whole numbers from 0, each below the vertex count), without `file`."},
       {"walls", "min", "m", "(box) Lower corner."},
       {"walls", "max", "m", "(box) Upper corner."},

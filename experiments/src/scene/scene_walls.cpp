@@ -97,6 +97,10 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
       }
       const std::string msg = w.mesh.validate();
       if (!msg.empty()) t.fail(t.has("file") ? "file" : "triangles", msg);
+      // After the scale: places a part in the scene, or moves one (one key raises
+      // the heap's funnel).
+      const Vec3 offset = t.vec3("offset", Vec3::Zero());
+      for (Vec3& v : w.mesh.vertices) v += offset;
       model.walls.push_back(w);
     } else {  // box: five planes (open top) or six, facing inwards
       const Vec3 lo = t.requiredVec3("min"), hi = t.requiredVec3("max");
