@@ -190,12 +190,16 @@ fi
 # discharge. Wall time of each whole process (start-up and output included), seconds. small:
 # rocklab on 2 threads and LIGGGHTS on 1 process (the issue's comparison); full: both engines on 1
 # and 2. The check: the clumps LIGGGHTS still holds at the end (rocklab's are all out).
+# ROCKLAB_CHUTE_ARGS: more arguments for rocklab's runs, e.g. the larger step the issue allows
+# where the contact-network check accepts it: "--set timestep.dt=9e-7 --set timestep.allow_unsafe=true".
 if [ "$which_scenes" = chute ]; then
   printf '\nchute,clumps,simulated_s,rocklab_1t_s,rocklab_2t_s,liggghts_1p_s,liggghts_2p_s,ratio_2t_vs_1p,ratio_1t_vs_1p,ratio_2t_vs_2p,clearance_s,clumps_left_liggghts\n'
   seconds() { date +%s.%N; }
   chute_rocklab() {  # threads -> sets wall (s); the run folder rocklab-chute-T
     local dir="$out/rocklab-chute-$1" t0; t0=$(seconds)
-    "$rocklab" run "$root/assets/scenes/chute-30-clumps.toml" --out "$dir" --overwrite --threads "$1" --quiet >"$dir.log" 2>&1
+    # shellcheck disable=SC2086  # ROCKLAB_CHUTE_ARGS is a list of words on purpose
+    "$rocklab" run "$root/assets/scenes/chute-30-clumps.toml" --out "$dir" --overwrite --threads "$1" --quiet \
+      ${ROCKLAB_CHUTE_ARGS:-} >"$dir.log" 2>&1
     wall=$(echo "$(seconds) - $t0" | bc -l)
   }
   chute_peer() {  # procs -> sets pwall (s) and left (clumps at the end); empty without the peer

@@ -227,6 +227,36 @@ TEST_CASE("a scene extends another and changes only what it names", "[scene]") {
                     Contains("x.toml:1: key 'extends' = \"nowhere.toml\": cannot open"));
 }
 
+TEST_CASE("an extending scene removes inherited entries by name, and a name that matches nothing is refused",
+          "[scene]") {
+  const std::string dir = std::string(ROCKLAB_SOURCE_DIR) + "/assets/scenes/";
+  const Scene zoned = loadScene(dir + "zoned-chute.toml");
+  const Scene single = loadScene(dir + "zoned-chute-single.toml");
+  auto names = [](const Scene& s) {
+    std::vector<std::string> n;
+    for (const auto& w : s.model.walls) n.push_back(w.name);
+    return n;
+  };
+  std::vector<std::string> kept = names(zoned);
+  std::erase_if(kept, [](const std::string& n) { return n == "zone_wall_1" || n == "zone_wall_2"; });
+  REQUIRE(kept.size() + 2 == zoned.model.walls.size());
+  CHECK(names(single) == kept);  // the rest in their order
+  const std::string extend = "extends = \"zoned-chute.toml\"\n";
+  CHECK_THROWS_WITH(loadSceneText(extend + "remove = [\"walls.zone_wall_3\"]\n", "x.toml", {}, dir),
+                    Contains("x.toml:2: key 'remove' entry \"walls.zone_wall_3\": no [[walls]] entry is named "
+                             "'zone_wall_3'") &&
+                        Contains("zone_wall_1, zone_wall_2"));
+  CHECK_THROWS_WITH(loadSceneText(extend + "remove = [\"floors.base\"]\n", "x.toml", {}, dir),
+                    Contains("the scene has no array of tables [[floors]]"));
+  CHECK_THROWS_WITH(loadSceneText(extend + "remove = [\"walls\"]\n", "x.toml", {}, dir),
+                    Contains("expected ARRAY.NAME"));
+  CHECK_THROWS_WITH(loadSceneText(extend + "remove = \"walls.gate\"\n", "x.toml", {}, dir),
+                    Contains("key 'remove': expected a list"));
+  // Removing an entry twice: the second finds nothing.
+  CHECK_THROWS_WITH(loadSceneText(extend + "remove = [\"walls.gate\", \"walls.gate\"]\n", "x.toml", {}, dir),
+                    Contains("no [[walls]] entry is named 'gate'"));
+}
+
 TEST_CASE("messages name the --set or file - line of the key they blame - with short numbers", "[scene]") {
   // A table only a --set made: the override, not "<scene>".
   const std::string made = errorOf(kMinimal, {"foo.bar=1"});

@@ -66,12 +66,70 @@ void mergeInto(toml::table& base, const toml::table& over) {
   }
 }
 
+/// `remove = ["walls.zone_wall_1", ...]`: drops each named entry of an array of
+/// tables after `extends` has merged, so that an extending scene can leave out
+/// an inherited wall (or particle set, camera, ...) without repeating the whole
+/// array (an array of tables replaces the base's whole). Each entry is
+/// ARRAY.NAME, the entry found by its `name` as `--set` finds it; one that names
+/// nothing is refused, listing the names the array has.
+struct Removals {
+  std::string at;  // "file:line: key 'remove'", read before the merge (a merged copy has no source)
+  std::vector<std::string> entries;
+};
+
+Removals takeRemovals(toml::table& table) {
+  Removals removals;
+  const toml::node* r = table.get("remove");
+  if (!r) return removals;
+  removals.at = detail::where(r->source()) + "key 'remove'";
+  const std::string expected = ": expected a list of \"ARRAY.NAME\" strings, e.g. [\"walls.zone_wall_1\"]";
+  const toml::array* list = r->as_array();
+  if (!list) throw SceneError(removals.at + expected);
+  for (const toml::node& item : *list) {
+    const auto entry = item.value<std::string>();
+    if (!entry) throw SceneError(removals.at + expected);
+    removals.entries.push_back(*entry);
+  }
+  table.erase("remove");
+  return removals;
+}
+
+void applyRemovals(toml::table& table, const Removals& removals) {
+  for (const std::string& entry : removals.entries) {
+    const std::string named = removals.at + " entry \"" + entry + "\"";
+    const std::size_t dot = entry.find('.');
+    if (dot == std::string::npos || dot == 0 || dot + 1 == entry.size())
+      throw SceneError(named + ": expected ARRAY.NAME, e.g. \"walls.zone_wall_1\"");
+    const std::string array_key = entry.substr(0, dot), name = entry.substr(dot + 1);
+    toml::array* array = table[array_key].as_array();
+    if (!array || !array->is_array_of_tables())
+      throw SceneError(named + ": the scene has no array of tables [[" + array_key + "]]");
+    std::string names;
+    bool found = false;
+    for (auto it = array->begin(); it != array->end(); ++it) {
+      const auto entry_name = (*it->as_table())["name"].value<std::string>();
+      if (entry_name && *entry_name == name) {
+        array->erase(it);
+        found = true;
+        break;
+      }
+      names += (names.empty() ? "" : ", ") + entry_name.value_or("(unnamed)");
+    }
+    if (!found)
+      throw SceneError(named + ": no [[" + array_key + "]] entry is named '" + name + "' (names: " +
+                       (names.empty() ? "none" : names) + ")");
+  }
+}
+
 /// A scene may start with `extends = "other.toml"` (path relative to the
 /// scene): it then holds only what differs from that scene, e.g. another
-/// inclination.
+/// inclination, and may `remove` inherited entries of arrays of tables.
 void resolveExtends(toml::table& table, const std::filesystem::path& base_dir, int depth) {
   const toml::node* e = table.get("extends");
-  if (!e) return;
+  if (!e) {
+    applyRemovals(table, takeRemovals(table));
+    return;
+  }
   const auto name = e->value<std::string>();
   const std::string at = detail::where(e->source()) + "key 'extends'";
   if (!name) throw SceneError(at + ": expected the file name of the scene to extend");
@@ -87,8 +145,10 @@ void resolveExtends(toml::table& table, const std::filesystem::path& base_dir, i
   toml::table base = parseToml(buf.str(), file.string());
   resolveExtends(base, file.parent_path(), depth + 1);
   table.erase("extends");
+  const Removals removals = takeRemovals(table);
   mergeInto(base, table);
   table = std::move(base);
+  applyRemovals(table, removals);
 }
 
 }  // namespace
