@@ -70,8 +70,9 @@ void mergeInto(toml::table& base, const toml::table& over) {
 /// tables after `extends` has merged, so that an extending scene can leave out
 /// an inherited wall (or particle set, camera, ...) without repeating the whole
 /// array (an array of tables replaces the base's whole). Each entry is
-/// ARRAY.NAME, the entry found by its `name` as `--set` finds it; one that names
-/// nothing is refused, listing the names the array has.
+/// ARRAY.NAME, the entry found by its `name` as `--set` finds it
+/// (detail::namedEntryIndex); one that names nothing is refused, listing the
+/// names the array has.
 struct Removals {
   std::string at;  // "file:line: key 'remove'", read before the merge (a merged copy has no source)
   std::vector<std::string> entries;
@@ -104,20 +105,15 @@ void applyRemovals(toml::table& table, const Removals& removals) {
     toml::array* array = table[array_key].as_array();
     if (!array || !array->is_array_of_tables())
       throw SceneError(named + ": the scene has no array of tables [[" + array_key + "]]");
-    std::string names;
-    bool found = false;
-    for (auto it = array->begin(); it != array->end(); ++it) {
-      const auto entry_name = (*it->as_table())["name"].value<std::string>();
-      if (entry_name && *entry_name == name) {
-        array->erase(it);
-        found = true;
-        break;
-      }
-      names += (names.empty() ? "" : ", ") + entry_name.value_or("(unnamed)");
-    }
-    if (!found)
+    const std::size_t idx = detail::namedEntryIndex(*array, name);
+    if (idx == array->size()) {
+      std::string names;
+      for (const toml::node& e : *array)
+        names += (names.empty() ? "" : ", ") + (*e.as_table())["name"].value_or(std::string("(unnamed)"));
       throw SceneError(named + ": no [[" + array_key + "]] entry is named '" + name + "' (names: " +
                        (names.empty() ? "none" : names) + ")");
+    }
+    array->erase(array->cbegin() + static_cast<std::ptrdiff_t>(idx));
   }
 }
 

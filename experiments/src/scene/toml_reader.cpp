@@ -454,6 +454,15 @@ std::string setArrayEntry(toml::array& numbers, const std::string& index, const 
 
 }  // namespace
 
+std::size_t namedEntryIndex(const toml::array& array, const std::string& name) {
+  std::size_t idx = array.size();
+  for (std::size_t e = 0; e < array.size(); ++e)
+    if (const auto* entry = array.get(e)->as_table();
+        entry && entry->get("name") && entry->get("name")->value<std::string>() == name)
+      idx = e;
+  return idx;
+}
+
 std::string applyOverride(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -501,11 +510,7 @@ std::string applyOverride(toml::table& root, const std::string& assignment) {
       indexed += parts[k] + ".";
     } else if (auto a = cur->as_array()) {
       // An index, or the name of an entry (walls.gate.active_until = ...).
-      std::size_t idx = a->size();
-      for (std::size_t e = 0; e < a->size(); ++e)
-        if (const auto* entry = a->get(e)->as_table();
-            entry && entry->get("name") && entry->get("name")->value<std::string>() == parts[k])
-          idx = e;
+      std::size_t idx = namedEntryIndex(*a, parts[k]);
       if (idx == a->size()) {
         if (parts[k].find_first_not_of("0123456789") != std::string::npos)
           throw SceneError("--set " + assignment + ": '" + parts[k] +

@@ -118,6 +118,10 @@ class TableReader {
 
 /// "file:line: " for a node.
 std::string where(const toml::source_region& src);
+/// The index of the entry of an array of tables whose `name` is `name` (the last
+/// such entry), or array.size() when none is: how `--set walls.gate.x=...` and
+/// `remove = ["walls.gate"]` find an entry.
+std::size_t namedEntryIndex(const toml::array& array, const std::string& name);
 /// Sets `key.path=value` in `root`; throws SceneError naming the override.
 /// Returns the dotted key with array indices (walls.gate.x -> walls.2.x). A
 /// last part that is an index into an array of numbers sets that number
