@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <sstream>
+#include <string>
 
 #include "cli_support.h"
 #include "crusher/breakage_freeze.h"
@@ -985,6 +987,39 @@ TEST_CASE("a tiny crusher run with breakage: balls break, the fragments are disc
       CHECK(events == first_events);
     fs::remove_all(out);
   }
+}
+
+TEST_CASE("breakage start: \"feed\" breaks weak balls on the stop wall, \"release\" checks from the stop wall's "
+          "removal on",
+          "[cli][crusher]") {
+  // Balls of 2 kPa strength break at their first impact. The stop wall goes at
+  // 0.15 s: under "feed" (the default) they break in the bin on it, under "release"
+  // no check is made before 0.15 s and they break in the chamber.
+  double first_feed = 0, first_release = 0;
+  for (const std::string start : {"feed", "release"}) {
+    const fs::path out = test::scratchDir("crusher-breakage-start-" + start);
+    auto args = test::tinyCrusherRunArgs(out.string(), 1, "cone-crusher-pbm-breakage.toml");
+    for (const std::string& set : std::vector<std::string>{"experiment.breakage.q_ref=2e3", "experiment.breakage.check_interval=2e-5",
+                                  "experiment.breakage.youngs_modulus=1e8", "experiment.breakage.min_diameter=0.0079",
+                                  "timestep.dt=7e-7", "output.vtk=false", "crusher.release_time=0.15",
+                                  "scene.end_time=0.3", "experiment.breakage.start=\"" + start + "\""})
+      args.insert(args.end(), {"--set", set});
+    REQUIRE(test::cli(args) == 0);
+    std::ifstream in(out / "results.json");
+    const auto b = nlohmann::json::parse(in)["crusher"]["breakage"];
+    INFO(start << ": " << b.dump());
+    CHECK(b["start"] == start);
+    CHECK(b["checks_from_s"].get<double>() == (start == "feed" ? 0.0 : 0.15));
+    REQUIRE(b["events"].get<int>() >= 1);
+    std::istringstream events(test::slurp(out / "breakage.csv"));
+    std::string header, first;
+    std::getline(events, header);
+    std::getline(events, first);
+    (start == "feed" ? first_feed : first_release) = std::stod(first.substr(0, first.find(',')));
+    fs::remove_all(out);
+  }
+  CHECK(first_feed < 0.15);     // in the bin
+  CHECK(first_release >= 0.15); // in the chamber
 }
 
 TEST_CASE("a crusher run with breakage restarted from its checkpoint ends as the run that went straight through, bit "

@@ -88,10 +88,11 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
   if (spec.log_x) s += "set logscale x\n";
   if (spec.log_y) s += "set logscale y\n";
   s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\n";
-  // The key above the axes (inside them an opaque key hid the data points under it);
+  // The key above the axes (inside them an opaque key hid the data points under it),
+  // two characters wider than gnuplot reckons (pngcairo's labels overran its box);
   // none when no series has a label (an empty box otherwise).
   s += (std::any_of(spec.series.begin(), spec.series.end(), [](const PlotSeries& p) { return !p.label.empty(); })
-            ? "set key outside top center horizontal box\n"
+            ? "set key outside top center horizontal box width 2\n"
             : "unset key\n");
   const std::string size = std::to_string(spec.width) + "," + std::to_string(spec.height);
   s += "set terminal pngcairo noenhanced size " + size + " background rgb 'white' font 'sans,10'\nset output " +

@@ -26,6 +26,12 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   if (!b) return;
   s.enabled = true;
   s.check_interval = b->number("check_interval", s.check_interval, Range::nonNegative());
+  using Start = BreakageSettings::Start;
+  s.start = b->string("start", breakageStartName(s.start), {breakageStartName(Start::Feed),
+                                                             breakageStartName(Start::Release)}) ==
+                    breakageStartName(Start::Release)
+                ? Start::Release
+                : Start::Feed;
   s.strength.q_ref = b->number("q_ref", s.strength.q_ref, Range::positive());
   s.strength.d_ref = b->number("d_ref", s.strength.d_ref, Range::positive());
   s.strength.size_exponent = b->number("size_exponent", s.strength.size_exponent);
@@ -83,6 +89,10 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
 
 const char* crowdedBoundName(BreakageSettings::CrowdedBound bound) {
   return bound == BreakageSettings::CrowdedBound::Overlap ? "overlap" : "energy";
+}
+
+const char* breakageStartName(BreakageSettings::Start start) {
+  return start == BreakageSettings::Start::Release ? "release" : "feed";
 }
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(BreakageEvent, time, parent, diameter, q, strength, fragments, freeze_cycles,
@@ -510,6 +520,7 @@ nlohmann::json CrusherBreakage::report(const std::vector<double>& sieves_mm, con
   b["deferred"] = deferred;
   b["defer_time_s"] = s_.defer_time;
   b["check_interval_s"] = check_interval_;
+  b["start"] = breakageStartName(s_.start);
   b["check_interval_from"] = s_.check_interval > 0 ? "experiment.breakage.check_interval"
                                                    : "automatic: a quarter of the shortest contact time of a ball of "
                                                      "min_diameter on a wall";

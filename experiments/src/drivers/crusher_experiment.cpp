@@ -79,7 +79,7 @@ class CrusherRunExperiment final : public Experiment {
     }
     if (strengthened_ && world->time() >= release_time_) restoreBonds(world, ctx);
     if (world->particles().size() == 0) return false;  // the chamber is empty
-    if (e_.breakage.enabled && breakage_.check(world, ctx)) {
+    if (e_.breakage.enabled && world->time() >= breakageStart() && breakage_.check(world, ctx)) {
       chamber_mass_ = massOf(world->particles());
       const std::vector<BreakageEvent>& events = breakage_.events();
       for (; events_seen_ < events.size(); ++events_seen_)
@@ -338,6 +338,7 @@ class CrusherRunExperiment final : public Experiment {
     }
     if (e_.breakage.enabled) {
       nlohmann::json b = breakage_.report(e_.sieves_mm, out_dir);
+      b["checks_from_s"] = breakageStart();
       // Breakage conserves mass to round-off: the feed is the product and what is left.
       b["mass_balance"] = {{"feed_kg", feed_mass},
                            {"product_kg", product_mass},
@@ -377,6 +378,11 @@ class CrusherRunExperiment final : public Experiment {
   std::vector<std::size_t> fragment_balls_;        // balls of each discharged fragment
   std::vector<std::pair<double, double>> ball_count_;  // (s, balls in the run) every sample_interval
   double release_time_ = std::numeric_limits<double>::infinity();  // s, the stop wall goes
+  /// s, the first breakage check (BreakageSettings::start): t = 0, or the release
+  /// (t = 0 too in a scene without the stop wall: its feed falls into the chamber at once).
+  double breakageStart() const {
+    return e_.breakage.start == BreakageSettings::Start::Release && std::isfinite(release_time_) ? release_time_ : 0.0;
+  }
   bool strengthened_ = false;
   double restored_at_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> tensile_, shear_;  // the strengths before settle_bond_factor

@@ -311,6 +311,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"experiment.crusher", "whiten_exponent", "", "Exponent of Eq 3-22 (the study prints 2; Whiten's fits are often about 2.3)."},
       {"experiment.crusher.breakage", "", "", "[experiment.breakage] of type = \"crusher\": population-balance breakage (experiments.md §g.6, docs/crusher.md); off without the table. A ball of at least min_diameter whose octahedral shear stress exceeds its strength is replaced by fragments, which a freeze eases apart."},
       {"experiment.crusher.breakage", "check_interval", "s", "Time between breakage checks; 0 = automatic: a quarter of the contact time pi sqrt(m/k) of a ball of min_diameter on a wall, so every impact is seen near its peak (results.json: crusher.breakage.check_interval_s)."},
+      {"experiment.crusher.breakage", "start", "", "When the checks begin (§g.4 [X]): \"feed\" from t = 0, so the feed may break in the feed bin; \"release\" when the stop wall goes (crusher.release_time; t = 0 without a feed bin), so only the chamber breaks balls (results.json: crusher.breakage.start, checks_from_s).", "\"feed\", \"release\"", "\"feed\""},
       {"experiment.crusher.breakage", "q_ref", "Pa", "q0 at d_ref: the octahedral shear strength 37 % of the balls of that size exceed (Weibull scale)."},
       {"experiment.crusher.breakage", "d_ref", "m", "Size q_ref belongs to ([I]: 21 mm, the middle of the 14-28 mm feed)."},
       {"experiment.crusher.breakage", "size_exponent", "", "b of the size effect q0(d) = q_ref (d / d_ref)^b (Eq 6-13)."},
