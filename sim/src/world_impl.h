@@ -227,6 +227,10 @@ struct World::Impl {
               wall_triangle_distance.data() + wall_triangle_offset[candidate + 1]};
     }
     std::vector<Vec3> ref_position;          // [n] m, positions at the last rebuild
+    // [walls] whether each wall was active at the last rebuild: a mesh wall that was,
+    // and has not moved since, hands a ball that has not moved either its triangles
+    // of then (the same query's answer) instead of a new search of its tree.
+    std::vector<std::uint8_t> wall_active_at_build;
     double skin = 0.0;                       // m
     bool need_rebuild = true;
     double last_max_disp2 = 0.0;             // m^2, largest displacement since the rebuild

@@ -182,6 +182,28 @@ TEST_CASE("the fragments' overlaps found through a grid, and their largest throu
   CHECK(largest(p, fragments) == all.max_fraction);
   CHECK(largest(p, fragments) == all.max_fraction);
   CHECK(largest(p, {}) == 0.0);
+  // The freeze asks again as the balls move: shuffled by up to 1.4 mm a look, at the
+  // seventh look the fragments moved 4 mm besides; the largest against every pair
+  // each time, and a ball with no position (NaN) gives "no room".
+  const auto everyPair = [&] {
+    double worst = 0;
+    for (const std::uint32_t f : fragments)
+      for (std::uint32_t j = 0; j < p.size(); ++j) {
+        const double overlap = p.radius[f] + p.radius[j] - (p.position[f] - p.position[j]).norm();
+        if (j != f && overlap > 0) worst = std::max(worst, overlap / std::min(p.radius[f], p.radius[j]));
+      }
+    return worst;
+  };
+  for (int look = 0; look < 12; ++look) {
+    for (geometry::Vec3& x : p.position)
+      x += geometry::Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 0.0008;
+    if (look == 6)
+      for (const std::uint32_t f : fragments) p.position[f].z() += 0.004 * (f % 60 == 0 ? 1 : -1);
+    const double expected = everyPair();
+    CHECK(largest(p, fragments) == expected);
+  }
+  p.position[fragments[0]].x() = std::numeric_limits<double>::quiet_NaN();
+  CHECK(largest(p, fragments) == std::numeric_limits<double>::infinity());
   CHECK(crusher::fragmentOverlaps(model, p, {}).energy == 0.0);
 }
 

@@ -55,18 +55,45 @@ void World::Impl::rebuildNeighbours() {
   std::vector<Vec3> old_wshear = std::move(history.wall_shear);
   std::vector<Vec3> old_wnormal = std::move(history.wall_normal);
   std::vector<double> old_wrelax = std::move(relax.wall);
+  std::vector<std::uint32_t> old_tri_offset = std::move(nb.wall_triangle_offset);
+  std::vector<std::uint32_t> old_triangles = std::move(nb.wall_triangles);
+  std::vector<double> old_tri_distance = std::move(nb.wall_triangle_distance);
   nb.wall_offset.assign(n + 1, 0);
   nb.wall_index.clear();
   nb.wall_slot.clear();
   nb.wall_triangle_offset.assign(1, 0);
   nb.wall_triangles.clear();
   nb.wall_triangle_distance.clear();
+  // A mesh wall active at the last build and not moved since (a static wall, or the
+  // held walls of a breakage freeze): a ball at exactly its position of then gets its
+  // triangles of then, which the same search would return again. In a freeze most
+  // balls are held still, and the searches took a tenth of the sigma0 = 0.8 MPa run
+  // (perf, docs/crusher.md).
+  std::vector<std::uint8_t> wall_unchanged(walls.size(), 0);
+  if (old_offset.size() == n + 1 && nb.ref_position.size() == n && nb.wall_active_at_build.size() == walls.size())
+    for (std::size_t k = 0; k < walls.size(); ++k)
+      wall_unchanged[k] = model.walls[k].shape == WallShape::Mesh && walls[k].active &&
+                          nb.wall_active_at_build[k] && walls[k].displacementSinceReference() == 0.0;
+  const auto nearWall = [&](std::size_t i, std::size_t k) {
+    if (wall_unchanged[k] && p.position[i] == nb.ref_position[i]) {
+      for (std::uint32_t o = old_offset[i]; o < old_offset[i + 1]; ++o)
+        if (old_index[o] == k && old_slot[o] == 0) {
+          nb.wall_triangles.insert(nb.wall_triangles.end(), old_triangles.begin() + old_tri_offset[o],
+                                   old_triangles.begin() + old_tri_offset[o + 1]);
+          nb.wall_triangle_distance.insert(nb.wall_triangle_distance.end(),
+                                           old_tri_distance.begin() + old_tri_offset[o],
+                                           old_tri_distance.begin() + old_tri_offset[o + 1]);
+          return true;
+        }
+      return false;  // not near it then, so not now
+    }
+    return walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles,
+                         nb.wall_triangle_distance);
+  };
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t k = 0; k < walls.size(); ++k) {
       if (!walls[k].active) continue;
-      if (!walls[k].near(model.walls[k], p.position[i], p.radius[i] + nb.skin, nb.wall_triangles,
-                         nb.wall_triangle_distance))
-        continue;
+      if (!nearWall(i, k)) continue;
       const std::uint32_t slots = model.walls[k].shape == WallShape::Mesh ? kMeshWallSlots : 1;
       for (std::uint32_t s = 0; s < slots; ++s) {
         nb.wall_index.push_back(static_cast<std::uint32_t>(k));
@@ -91,6 +118,8 @@ void World::Impl::rebuildNeighbours() {
           }
   }
   nb.ref_position = p.position;
+  nb.wall_active_at_build.resize(walls.size());
+  for (std::size_t k = 0; k < walls.size(); ++k) nb.wall_active_at_build[k] = walls[k].active;
   for (auto& wr : walls) wr.setReference();
   nb.last_max_disp2 = 0.0;
   nb.need_rebuild = false;
