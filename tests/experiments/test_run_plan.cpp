@@ -365,6 +365,93 @@ TEST_CASE("samples --over scene.seed: the seeds one sweep varies are its samples
   fs::remove_all(dir);
 }
 
+namespace {
+
+/// A set of samples over scene.seed (`rocklab samples --over`) from stand-in runs of
+/// `values[damping][seed]` restitutions, at damping 0.1 and 0.2 (and, with `factors`,
+/// each at those safety factors, one seed).
+fs::path sampleSet(const fs::path& dir, const std::vector<std::vector<std::string>>& values,
+                   const std::vector<std::string>& factors = {}) {
+  const std::vector<std::string> damping{"0.1", "0.2"};
+  std::vector<std::string> vary{"sweep", "drop", "--vary", "contact.damping_normal=0.1,0.2", "--vary",
+                                factors.empty() ? "scene.seed=1,2,3" : "timestep.safety_factor=0.4,0.8",
+                                "--metric", "restitution", "--plan", dir.string()};
+  REQUIRE(cli(vary) == 0);
+  for (std::size_t v = 0; v < damping.size(); ++v)
+    for (std::size_t k = 0; k < values[v].size(); ++k) {
+      const std::string second = factors.empty() ? "scene.seed=" + std::to_string(k + 1)
+                                                 : "timestep.safety_factor=" + factors[k];
+      const fs::path run = dir / "runs" / ("contact.damping_normal=" + damping[v] + "__" + second);
+      fs::create_directories(run);
+      std::ofstream(run / "results.json") << "{\"status\": \"completed\", \"restitution\": " << values[v][k] << "}";
+    }
+  REQUIRE(cli({"collect", dir.string()}) == 0);
+  std::vector<std::string> merge{"samples", dir.string(), "--out", (dir / "merged").string()};
+  if (factors.empty()) merge.insert(merge.end(), {"--over", "scene.seed"});
+  REQUIRE(cli(merge) == 0);
+  return dir / "merged";
+}
+
+}  // namespace
+
+TEST_CASE("contrast: two sets of samples as the ratio or difference of their means, variant by variant, with the "
+          "scatter of both",
+          "[plan]") {
+  // A: damping 0.1 gives 0.70, 0.72, 0.74 over three seeds (mean 0.72, sd 0.02), 0.2 gives
+  // 0.60, 0.62, 0.64 (0.62, 0.02); B: 0.35, 0.36, 0.37 (0.36, 0.01) and 0.30, 0.31, 0.32
+  // (0.31, 0.01). Ratio at 0.1: 2, scatter 2 sqrt((0.02/0.72)^2 + (0.01/0.36)^2) = 0.0785674;
+  // difference 0.36, scatter sqrt(0.02^2 + 0.01^2) = 0.0223607.
+  const fs::path dir = fresh("contrast");
+  const fs::path a = sampleSet(dir / "a", {{"0.70", "0.72", "0.74"}, {"0.60", "0.62", "0.64"}});
+  const fs::path b = sampleSet(dir / "b", {{"0.35", "0.36", "0.37"}, {"0.30", "0.31", "0.32"}});
+  REQUIRE(cli({"contrast", a.string(), b.string(), "--out", (dir / "ratio").string()}) == 0);
+  auto table = lines(dir / "ratio" / "contrast.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[0] == "contact.damping_normal,restitution.value,restitution.scatter,restitution.n_a,restitution.n_b");
+  CHECK(table[1] == "0.1,2,0.0785674,3,3");
+  CHECK(table[2] == "0.2,2,0.0912396,3,3");
+  CHECK(lines(dir / "ratio" / "contrast.md")[2] == "| 0.1 | 2 ± 0.0786 (3, 3) |");
+  REQUIRE(cli({"contrast", a.string(), b.string(), "--op", "difference", "--out", (dir / "difference").string()}) == 0);
+  table = lines(dir / "difference" / "contrast.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[1] == "0.1,0.36,0.0223607,3,3");
+  CHECK(table[2] == "0.2,0.31,0.0223607,3,3");
+  const nlohmann::json j =
+      nlohmann::json::parse(rocklab::experiments::test::slurp(dir / "difference" / "contrast.json"));
+  CHECK(j["op"] == "difference");
+  CHECK(j["variants"][0]["figures"]["restitution"]["a"]["mean"].get<double>() == Approx(0.72));
+  CHECK(j["variants"][0]["figures"]["restitution"]["b"]["sd"].get<double>() == Approx(0.01));
+
+  // C varies a key A does not (the safety factor), one sample a variant: fixed by --where,
+  // its variants match A's on the damping; one sample has no scatter, so the contrast has none.
+  const fs::path c = sampleSet(dir / "c", {{"0.36", "0.40"}, {"0.31", "0.35"}}, {"0.4", "0.8"});
+  std::string log;
+  CHECK(rocklab::experiments::test::cliLogged({"contrast", a.string(), c.string(), "--out", (dir / "x").string()},
+                                              log) == 2);
+  CHECK(log.find("two variants with contact.damping_normal = 0.1") != std::string::npos);
+  CHECK(log.find("--where KEY=VALUE (its keys: timestep.safety_factor)") != std::string::npos);
+  REQUIRE(cli({"contrast", a.string(), c.string(), "--where", "timestep.safety_factor=0.4", "--out",
+               (dir / "where").string()}) == 0);
+  table = lines(dir / "where" / "contrast.csv");
+  REQUIRE(table.size() == 3);
+  CHECK(table[1] == "0.1,2,,3,1");
+  // Bad input: exit 2, the message naming what is allowed, nothing written.
+  CHECK(rocklab::experiments::test::cliLogged({"contrast", a.string(), c.string(), "--where",
+                                               "timestep.safety_factor=0.5", "--out", (dir / "x").string()},
+                                              log) == 2);
+  CHECK(log.find("allowed: 0.4, 0.8") != std::string::npos);
+  CHECK(rocklab::experiments::test::cliLogged(
+            {"contrast", a.string(), b.string(), "--where", "scene.seed=1", "--out", (dir / "x").string()}, log) == 2);
+  CHECK(log.find("neither set varies scene.seed") != std::string::npos);
+  CHECK(rocklab::experiments::test::cliLogged({"contrast", a.string(), dir.string(), "--out", (dir / "x").string()},
+                                              log) == 2);
+  CHECK(log.find((dir / "samples.json").string() + ": not found") != std::string::npos);
+  CHECK(cli({"contrast", a.string(), "--out", (dir / "x").string()}) == 2);
+  CHECK(cli({"contrast", a.string(), b.string(), "--op", "sum", "--out", (dir / "x").string()}) == 2);
+  CHECK_FALSE(fs::exists(dir / "x"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("samples.png leaves out a group in which no sample has the figure (every case jammed)", "[plan]") {
   // Two groups by the time-step factor; at 0.2 every run lacks the figure, as a zoned-chute
   // CSS whose every case jammed has no clearance time.

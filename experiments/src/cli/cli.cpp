@@ -18,6 +18,7 @@
 #include "crusher/crusher_geometry_command.h"
 #include "crusher/products_command.h"
 #include "analysis/profiles_command.h"
+#include "analysis/contrast_command.h"
 #include "analysis/samples_command.h"
 #include "analysis/sweeps_command.h"
 #include "crusher/whiten_command.h"
@@ -66,6 +67,7 @@ Examples:
   rocklab profiles runs/inclined runs/vertical --out out/deposition   # chute marker profiles side by side
   rocklab samples runs/lab-s1 runs/lab-s2 runs/lab-s3 --out runs/lab   # a sweep's mean and scatter over samples
   rocklab samples runs/chute --over scene.seed   # the same over the seeds one sweep varies
+  rocklab contrast runs/spheres/merged runs/clumps/merged   # ratio of two sample sets' means, variant by variant
   rocklab sweeps runs/css-large runs/css-medium --label "14.7 mm" --label "12.8 mm" --out runs/css-sizes   # sweeps as series
 
 Exit codes: 0 done, 1 the run failed (its reason in results.json), shape or calibrate
@@ -197,6 +199,8 @@ struct CliArgs {
   WhitenCommandOptions whiten;
   // products, profiles, samples (one of them a command line)
   RunComparisonOptions comparison;
+  std::string contrast_op = "ratio";
+  std::vector<std::string> where;
 };
 
 /// Threads and processes: 0 (the default) to 4096. CLI::NonNegativeNumber would
@@ -325,6 +329,17 @@ void addCommands(CLI::App& app, CliArgs& a) {
                       "The sweep.csv column to plot and print (default: the first with numbers)");
   samples->add_option("--over", a.group_by,
                       "A key the sweeps vary whose values are samples (e.g. scene.seed; default: a sample a folder)");
+  auto* contrast = addRunComparison(
+      app, a, "contrast",
+      "Two sets of samples (folders of `rocklab samples`) compared variant by variant: the ratio or difference of "
+      "every figure's means, with its scatter from both sets' standard deviations",
+      "Two folders written by `rocklab samples`, A then B", "contrast.csv, contrast.json and contrast.md");
+  contrast->add_option("--op", a.contrast_op, "ratio (A / B, the default) or difference (A - B)")
+      ->check(CLI::IsMember({"ratio", "difference"}));
+  contrast->add_option("--where", a.where,
+                       "KEY=VALUE: only the variants with that value of a key (for a key only one set varies, e.g. "
+                       "--where 'walls.top.corner=[0,0,0.05]')")
+      ->take_all();
   auto* sweeps = addRunComparison(
       app, a, "sweeps",
       "Finished sweeps of the same keys side by side, a series each (e.g. one deposit a clump size): their rows in "
@@ -607,9 +622,13 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
     a.whiten.out_dir = a.out_dir;
     return runWhitenCommand(a.whiten, std::cout, std::cerr);
   }
-  for (const std::string command : {"products", "profiles", "samples", "sweeps"}) {
+  for (const std::string command : {"products", "profiles", "samples", "sweeps", "contrast"}) {
     if (!app.got_subcommand(command)) continue;
     a.comparison.out_dir = a.out_dir.empty() ? std::filesystem::path("out") / command : std::filesystem::path(a.out_dir);
+    if (command == "contrast")
+      return runContrastCommand(
+          {a.comparison, a.contrast_op == "difference" ? ContrastOp::Difference : ContrastOp::Ratio, a.where},
+          std::cout, std::cerr);
     if (command == "products") return runProductsCommand(a.comparison, std::cout, std::cerr);
     if (command == "profiles") return runProfilesCommand(a.comparison, std::cout, std::cerr);
     if (command == "sweeps") return runSweepsCommand(a.comparison, a.figure, std::cout, std::cerr);
