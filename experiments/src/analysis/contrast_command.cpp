@@ -116,21 +116,16 @@ std::map<std::vector<std::string>, std::size_t> byCommonKeys(const SampleSet& s,
   return index;
 }
 
-std::string number(double x) {
-  if (!std::isfinite(x)) return "";
+/// x to `digits` significant digits; `none` when it is not finite.
+std::string text(double x, int digits, const char* none) {
+  if (!std::isfinite(x)) return none;
   std::ostringstream o;
-  o.precision(6);
+  o.precision(digits);
   o << x;
   return o.str();
 }
-
-std::string rounded(double x) {
-  if (!std::isfinite(x)) return "–";
-  std::ostringstream o;
-  o.precision(3);
-  o << x;
-  return o.str();
-}
+std::string number(double x) { return text(x, 6, ""); }    // the CSV's
+std::string rounded(double x) { return text(x, 3, "–"); }  // the Markdown's
 
 struct Contrasted {
   double value = NAN;
