@@ -27,18 +27,14 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   s.enabled = true;
   s.check_interval = b->number("check_interval", s.check_interval, Range::nonNegative());
   using Start = BreakageSettings::Start;
-  s.start = b->string("start", breakageStartName(s.start), {breakageStartName(Start::Feed),
-                                                             breakageStartName(Start::Release)}) ==
-                    breakageStartName(Start::Release)
-                ? Start::Release
-                : Start::Feed;
+  s.start = b->choice("start", s.start,
+                      {{Start::Feed, breakageStartName(Start::Feed)}, {Start::Release, breakageStartName(Start::Release)}});
   s.strength.q_ref = b->number("q_ref", s.strength.q_ref, Range::positive());
   s.strength.d_ref = b->number("d_ref", s.strength.d_ref, Range::positive());
   s.strength.size_exponent = b->number("size_exponent", s.strength.size_exponent);
   s.strength.weibull_modulus = b->number("weibull_modulus", s.strength.weibull_modulus, Range::positive());
   s.min_diameter = b->number("min_diameter", s.min_diameter, Range::positive());
-  s.mode = b->string("mode", "triple", {"triple", "equal"}) == "equal" ? crusher::SplitMode::Equal
-                                                                     : crusher::SplitMode::Triple;
+  s.mode = b->choice("mode", s.mode, {{crusher::SplitMode::Triple, "triple"}, {crusher::SplitMode::Equal, "equal"}});
   s.offsets = b->has("offsets") ? b->numberList("offsets") : crusher::defaultOffsets(s.mode);
   if (const std::string problem = crusher::offsetsProblem(s.mode, s.offsets); !problem.empty())
     b->fail("offsets", problem);
@@ -46,9 +42,10 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   s.class_ratio = b->number("class_ratio", s.class_ratio,
                             {1.0, std::numeric_limits<double>::infinity(), true, false});
   crusher::FreezeSettings& f = s.freeze;
-  f.scope = b->string("freeze_scope", crusher::freezeScopeName(f.scope), {"local", "all"}) == "all"
-                ? crusher::FreezeScope::All
-                : crusher::FreezeScope::Local;
+  using crusher::FreezeScope;
+  f.scope = b->choice("freeze_scope", f.scope,
+                      {{FreezeScope::Local, crusher::freezeScopeName(FreezeScope::Local)},
+                       {FreezeScope::All, crusher::freezeScopeName(FreezeScope::All)}});
   f.held_density = b->number("freeze_held_density", f.held_density, Range::positive());
   f.local_reach = b->number("freeze_local_reach", f.local_reach, Range::positive());
   f.density = b->number("freeze_density", f.density, Range::positive());
@@ -68,19 +65,15 @@ void readBreakageSettings(detail::TableReader& experiment_table, BreakageSetting
   if (b->has("freeze_defer_crowded"))
     b->fail("freeze_defer_crowded", "replaced by freeze_crowded: true is \"defer\", false is \"stop\"");
   using crusher::CrowdedOutcome;
-  const std::vector<CrowdedOutcome> outcomes{CrowdedOutcome::Break, CrowdedOutcome::Defer, CrowdedOutcome::Stop};
-  std::vector<std::string> names;
-  for (const CrowdedOutcome o : outcomes) names.push_back(crusher::crowdedOutcomeName(o));
-  const std::string crowded = b->string("freeze_crowded", crusher::crowdedOutcomeName(f.crowded), names);
-  for (const CrowdedOutcome o : outcomes)
-    if (crowded == crusher::crowdedOutcomeName(o)) f.crowded = o;
+  std::vector<std::pair<CrowdedOutcome, std::string>> outcomes;
+  for (const CrowdedOutcome o : {CrowdedOutcome::Break, CrowdedOutcome::Defer, CrowdedOutcome::Stop})
+    outcomes.emplace_back(o, crusher::crowdedOutcomeName(o));
+  f.crowded = b->choice("freeze_crowded", f.crowded, outcomes);
   s.crowded_max_overlap = b->number("freeze_crowded_max_overlap", s.crowded_max_overlap, Range::nonNegative());
   using Bound = BreakageSettings::CrowdedBound;
-  s.crowded_bound = b->string("freeze_crowded_bound", crowdedBoundName(s.crowded_bound),
-                              {crowdedBoundName(Bound::Energy), crowdedBoundName(Bound::Overlap)}) ==
-                            crowdedBoundName(Bound::Overlap)
-                        ? Bound::Overlap
-                        : Bound::Energy;
+  s.crowded_bound = b->choice("freeze_crowded_bound", s.crowded_bound,
+                              {{Bound::Energy, crowdedBoundName(Bound::Energy)},
+                               {Bound::Overlap, crowdedBoundName(Bound::Overlap)}});
   s.crowded_energy_factor =
       b->number("freeze_crowded_energy_factor", s.crowded_energy_factor, Range::nonNegative());
   s.defer_time = b->number("defer_time", s.defer_time, Range::nonNegative());

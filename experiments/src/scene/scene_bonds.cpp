@@ -45,9 +45,8 @@ void readBonds(TableReader& root, std::uint64_t seed, Scene& scene) {
     // Per unit area: the study's "N/m" are N/m^3 = Pa/m (dem-models §8.2 [I]).
     bm.normal_stiffness = t->requiredNumber("normal_stiffness", Range::positive());
     bm.shear_stiffness = t->requiredNumber("shear_stiffness", Range::nonNegative());
-    bm.failure_rule = t->string("failure_rule", "stress", {"stress", "combined"}) == "stress"
-                          ? sim::BondFailureRule::Stress
-                          : sim::BondFailureRule::Combined;
+    bm.failure_rule = t->choice("failure_rule", sim::BondFailureRule::Stress,
+                                {{sim::BondFailureRule::Stress, "stress"}, {sim::BondFailureRule::Combined, "combined"}});
     tensile = t->requiredNumber("tensile_strength", Range::positive());  // Pa
     shear = t->number("shear_strength", tensile, Range::positive());     // Pa
   } else {

@@ -105,9 +105,7 @@ void readCameras(TableReader& root, std::vector<CameraSettings>& cameras) {
     c.ambient = t.number("ambient", c.ambient, Range::closed(0, 2));
     c.diffuse = t.number("diffuse", c.diffuse, Range::closed(0, 2));
     c.specular = t.number("specular", c.specular, Range::closed(0, 2));
-    c.colour_by = t.string("colour_by", "material", {"material", "fragment"}) == "fragment"
-                      ? ColourBy::Fragment
-                      : ColourBy::Material;
+    c.colour_by = t.choice("colour_by", c.colour_by, {{ColourBy::Material, "material"}, {ColourBy::Fragment, "fragment"}});
     if (c.motion_blur && !(cam.exposureTime > 0)) t.fail("motion_blur", "needs exposure > 0 s");
     if (auto cut = t.table("cut")) c.cut = readCut(*cut, eye, target, up);
     t.finish();

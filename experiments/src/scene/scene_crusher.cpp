@@ -29,11 +29,10 @@ geometry::ConeCrusherSpec readSpec(TableReader& t) {
   s.eccentric_angle_deg = t.number("eccentric_angle_deg", s.eccentric_angle_deg, open_angle);
   s.parallel_length = t.number("parallel_length", s.parallel_length, Range::positive());
   s.mantle_diameter = t.number("mantle_diameter", s.mantle_diameter, Range::positive());
-  s.mantle_top_x = t.string("mantle_top_x", "corrected", {"corrected", "printed"}) == "printed"
-                       ? geometry::MantleTopX::Printed
-                       : geometry::MantleTopX::Corrected;
-  s.pivot = t.string("pivot", "axis", {"axis", "eq6-1"}) == "eq6-1" ? geometry::PivotPlacement::Eq61
-                                                                      : geometry::PivotPlacement::AxisPivot;
+  s.mantle_top_x = t.choice("mantle_top_x", s.mantle_top_x,
+                            {{geometry::MantleTopX::Corrected, "corrected"}, {geometry::MantleTopX::Printed, "printed"}});
+  s.pivot = t.choice("pivot", s.pivot,
+                     {{geometry::PivotPlacement::AxisPivot, "axis"}, {geometry::PivotPlacement::Eq61, "eq6-1"}});
   s.segments = static_cast<int>(t.integer("segments", s.segments, Range::closed(3, 100000)));
   return s;
 }

@@ -11,6 +11,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rocklab/experiments/scene.h"
@@ -63,6 +64,21 @@ class TableReader {
   std::string string(const std::string& key, const std::string& fallback,
                      const std::vector<std::string>& allowed = {});
   std::string requiredString(const std::string& key, const std::vector<std::string>& allowed = {});
+  /// A string key that names one of a fixed set of values: `options` pairs each value
+  /// with its name, the allowed strings; `fallback`'s name is the default.
+  template <class Value>
+  Value choice(const std::string& key, Value fallback, const std::vector<std::pair<Value, std::string>>& options) {
+    std::vector<std::string> names;
+    std::string fallback_name;
+    for (const auto& [value, name] : options) {
+      names.push_back(name);
+      if (value == fallback) fallback_name = name;
+    }
+    const std::string read = string(key, fallback_name, names);
+    for (const auto& [value, name] : options)
+      if (name == read) return value;
+    return fallback;
+  }
   geometry::Vec3 vec3(const std::string& key, const geometry::Vec3& fallback);
   geometry::Vec3 requiredVec3(const std::string& key);
   std::vector<geometry::Vec3> vec3List(const std::string& key);
