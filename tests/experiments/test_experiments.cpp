@@ -458,8 +458,13 @@ TEST_CASE("zoned chute: stopped in its deposit, at its end (stop_after) or in it
   const std::string rows = test::slurp(dir / "profiles" / "profiles.csv");
   CHECK(static_cast<std::size_t>(std::count(rows.begin(), rows.end(), '\n')) ==
         1 + css50["markers"].size() + css40["markers"].size());
-  for (const char* png : {"profile_column_1.png", "profile_column_3.png", "discharge.png"})
+  for (const char* png : {"profile_column_1.png", "profile_column_3.png", "discharge.png", "profiles.png"})
     CHECK(fs::file_size(dir / "profiles" / png) > 1000);
+  // The columns side by side: every column's points, named by their panel.
+  const std::string row_data = test::slurp(dir / "profiles" / "profiles.plot.csv");
+  CHECK(static_cast<std::size_t>(std::count(row_data.begin(), row_data.end(), '\n')) ==
+        1 + css50["markers"].size() + css40["markers"].size());
+  CHECK_THAT(row_data, Catch::Contains("\n\"column 1, 100 mm from the outlet (DEM truth): "));
   // Not a chute run: exit 2, naming the file.
   CHECK(test::cli({"profiles", (dir / "plates").string(), "--out", (dir / "bad").string()}) == 2);
   CHECK_FALSE(fs::exists(dir / "bad"));

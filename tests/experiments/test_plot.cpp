@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -194,4 +195,47 @@ TEST_CASE("CSV cells: a comma, a quote or a line break stays in its cell, writte
   REQUIRE(table.rows.size() == 1);
   CHECK(table.rows[0] == std::vector<std::string>{"[0,0,0.04]", "2.5", "ok"});
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("panels side by side: one image as wide as the panels, each panel's own range, the data named by panel", "[plot]") {
+  const fs::path dir = tempDir("row");
+  PlotSpec left, right;
+  left.title = "zone 1";
+  right.title = "zone 2";
+  left.x_label = right.x_label = "velocity (m/s)";
+  left.y_label = right.y_label = "height (mm)";
+  left.width = right.width = 400;
+  left.height = 300;
+  right.height = 250;  // the shorter panel is padded to the row's height
+  left.series = {{"inclined", {0.3, 0.35}, {10, 70}}};
+  right.series = {{"inclined", {0.15, 0.2}, {20, 120}}, {"vertical", {0.14, 0.21}, {15, 110}}};
+  right.series[1].colour = 1;
+  for (const bool gnuplot : {true, false}) {
+    if (gnuplot && rocklab::experiments::detail::gnuplotProgram().empty())
+      FAIL("gnuplot is not installed (scripts/setup.sh installs gnuplot-nox)");
+    const fs::path png = dir / (gnuplot ? "row.png" : "row-builtin.png");
+    {
+      std::unique_ptr<ScopedEnv> none;
+      if (!gnuplot) none = std::make_unique<ScopedEnv>("ROCKLAB_GNUPLOT", "none");
+      writePlotRow({left, right}, png);
+    }
+    const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+    REQUIRE(!img.empty());
+    CHECK(img.cols == 800);
+    CHECK(img.rows == 300);
+    // Both panels are drawn: palette colour 0 in each half, colour 1 only in the right one.
+    CHECK(countColour(img(cv::Rect(0, 0, 400, 300)), {178, 114, 0}) > 20);
+    CHECK(countColour(img(cv::Rect(400, 0, 400, 300)), {178, 114, 0}) > 20);
+    CHECK(countColour(img(cv::Rect(0, 0, 400, 300)), {0, 94, 213}) == 0);
+    CHECK(countColour(img(cv::Rect(400, 0, 400, 300)), {0, 94, 213}) > 20);
+    CHECK(fs::exists(dir / (gnuplot ? "row.svg" : "row-builtin.svg")) == gnuplot);
+    const std::string csv = slurpText(plotDataPath(png));
+    CHECK_THAT(csv, StartsWith("series,velocity (m/s),height (mm)\n"));
+    CHECK_THAT(csv, Contains("zone 1: inclined,0.3,10\n") && Contains("zone 2: inclined,0.15,20\n") &&
+                        Contains("zone 2: vertical,0.21,110\n"));
+  }
+  CHECK_THROWS_WITH(writePlotRow({}, dir / "none.png"), Contains("no panel"));
+  right.width = 100;
+  CHECK_THROWS_WITH(writePlotRow({left, right}, dir / "small.png"), Contains("at least 200 x 150"));
+  CHECK_FALSE(fs::exists(dir / "small.png"));
 }

@@ -107,28 +107,48 @@ PlotSpec sieveChart(std::string title) {
   return spec;
 }
 
-void writePlot(const PlotSpec& spec, const std::filesystem::path& png) {
-  if (spec.width < 200 || spec.height < 150)
-    throw std::invalid_argument("plot '" + png.string() + "': size must be at least 200 x 150 pixels");
-  for (const PlotSeries& s : spec.series)
-    if (s.x.size() != s.y.size())
-      throw std::invalid_argument("plot '" + png.string() + "': series '" + s.label + "' has " +
-                                  std::to_string(s.x.size()) + " x values but " + std::to_string(s.y.size()) +
-                                  " y values");
-  detail::axisRange(spec, true);  // a bad fixed range is refused before anything is written
-  detail::axisRange(spec, false);
+void writePlot(const PlotSpec& spec, const std::filesystem::path& png) { writePlotRow({spec}, png); }
+
+void writePlotRow(const std::vector<PlotSpec>& panels, const std::filesystem::path& png) {
+  if (panels.empty()) throw std::invalid_argument("plot '" + png.string() + "': no panel to draw");
+  for (const PlotSpec& spec : panels) {
+    if (spec.width < 200 || spec.height < 150)
+      throw std::invalid_argument("plot '" + png.string() + "': size must be at least 200 x 150 pixels");
+    for (const PlotSeries& s : spec.series)
+      if (s.x.size() != s.y.size())
+        throw std::invalid_argument("plot '" + png.string() + "': series '" + s.label + "' has " +
+                                    std::to_string(s.x.size()) + " x values but " + std::to_string(s.y.size()) +
+                                    " y values");
+    detail::axisRange(spec, true);  // a bad fixed range is refused before anything is written
+    detail::axisRange(spec, false);
+  }
 
   if (const std::string gnuplot = detail::gnuplotProgram(); !gnuplot.empty()) {
-    detail::drawPlotWithGnuplot(spec, png, gnuplot);
+    detail::drawPlotWithGnuplot(panels, png, gnuplot);
   } else {
     static std::once_flag said;
     std::call_once(said, [] {
       std::cerr << "rocklab: gnuplot not found (Debian: gnuplot-nox): plots are drawn as PNG only, by the built-in "
                    "plotter (no SVG; a log axis shows log10 of the values)\n";
     });
-    detail::drawPlotWithOpenCv(spec, png);
+    detail::drawPlotWithOpenCv(panels, png);
   }
-  detail::writeAtomically(plotDataPath(png), plotCsv(spec));  // after the plot: an error names the plot first
+  // The plotted data, after the plot (an error names the plot first): the panels'
+  // series one after the other, named by their panel when there are several.
+  PlotSpec data = panels.front();
+  if (panels.size() > 1) {
+    data.series.clear();
+    for (const PlotSpec& panel : panels)
+      for (std::size_t k = 0; k < panel.series.size(); ++k) {
+        PlotSeries s = panel.series[k];
+        const std::string name = !s.data_name.empty() ? s.data_name
+                                 : s.label.empty()    ? "series " + std::to_string(k + 1)
+                                                      : s.label;
+        s.data_name = panel.title + ": " + name;
+        data.series.push_back(std::move(s));
+      }
+  }
+  detail::writeAtomically(plotDataPath(png), plotCsv(data));
 }
 
 }  // namespace rocklab::experiments

@@ -51,6 +51,11 @@ PlotSpec sieveChart(std::string title);
 /// a series has x and y of different lengths, the size is too small or a fixed range is bad.
 void writePlot(const PlotSpec& spec, const std::filesystem::path& png);
 
+/// Panels side by side in one figure (a velocity profile a zone), each drawn as
+/// writePlot draws it at its own width and height; the same files and errors. In the
+/// plotted data a point's series is "PANEL TITLE: SERIES" when there is more than one panel.
+void writePlotRow(const std::vector<PlotSpec>& panels, const std::filesystem::path& png);
+
 /// "<stem>.plot.csv" beside the PNG: series, x, y, one row a point, as given (non-finite too).
 std::filesystem::path plotDataPath(const std::filesystem::path& png);
 

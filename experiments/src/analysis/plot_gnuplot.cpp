@@ -1,5 +1,6 @@
 // writePlot's gnuplot drawing (plot_internal.h): one script (data inline), run as
-// a child process; PNG by pngcairo and SVG from the same plot.
+// a child process; PNG by pngcairo and SVG from the same commands (panels side by
+// side as a multiplot).
 #include <algorithm>
 #include <fcntl.h>
 #include <spawn.h>
@@ -55,8 +56,14 @@ std::string withStyle(PlotSeries::Style style) {
   return "with linespoints lw 2 pt 7 ps 0.9";
 }
 
-std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::path& svg_partial) {
-  std::string s = "set encoding utf8\n";  // noenhanced on each terminal: labels are text, not markup
+/// One panel's data blocks (named "$<prefix><k>") and the commands that draw it; the
+/// commands set everything a panel uses, so panels of a multiplot do not inherit.
+struct PanelScript {
+  std::string data, commands;
+};
+
+PanelScript panelScript(const PlotSpec& spec, const std::string& prefix) {
+  PanelScript out;
   std::string plot;
   for (std::size_t k = 0; k < spec.series.size(); ++k) {
     const PlotSeries& series = spec.series[k];
@@ -73,18 +80,20 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
       data += number(series.x[i]) + " " + number(series.y[i]) + "\n";
     }
     if (!any) continue;  // gnuplot refuses a data block without points
-    const std::string block = "$s" + std::to_string(k);
-    s += block + " << EOD\n" + data + "EOD\n";
+    const std::string block = "$" + prefix + std::to_string(k);
+    out.data += block + " << EOD\n" + data + "EOD\n";
     plot += std::string(plot.empty() ? "plot " : ", ") + block + " using 1:2 " + withStyle(series.style) +
             " lc rgb '" + kPalette[colourIndexOf(series, k) % kPalette.size()] + "' " +
             (series.label.empty() ? std::string("notitle") : "title " + quoted(series.label));
   }
   if (plot.empty()) plot = "plot NaN notitle";  // axes only
   const AxisRange xr = axisRange(spec, true), yr = axisRange(spec, false);
+  std::string& s = out.commands;
   s += "set title " + quoted(spec.title) + "\nset xlabel " + quoted(spec.x_label) + "\nset ylabel " +
        quoted(spec.y_label) + "\n";
   s += "set xrange [" + number(xr.lo) + ":" + number(xr.hi) + "]\nset yrange [" + number(yr.lo) + ":" +
        number(yr.hi) + "]\n";
+  s += "unset logscale\n";
   if (spec.log_x) s += "set logscale x\n";
   if (spec.log_y) s += "set logscale y\n";
   s += "set grid lc rgb '#e4e4e4' lt 1\nset border lc rgb '#1e1e1e'\n";
@@ -94,11 +103,29 @@ std::string script(const PlotSpec& spec, const fs::path& png_partial, const fs::
   s += (std::any_of(spec.series.begin(), spec.series.end(), [](const PlotSeries& p) { return !p.label.empty(); })
             ? "set key outside top center horizontal box width 2\n"
             : "unset key\n");
-  const std::string size = std::to_string(spec.width) + "," + std::to_string(spec.height);
+  s += plot + "\n";
+  return out;
+}
+
+/// The script for panels side by side (one panel: a plain plot), drawn once as PNG
+/// and once as SVG.
+std::string script(const std::vector<PlotSpec>& panels, const fs::path& png_partial, const fs::path& svg_partial) {
+  std::string s = "set encoding utf8\n";  // noenhanced on each terminal: labels are text, not markup
+  std::string body;
+  int width = 0, height = 0;
+  for (std::size_t p = 0; p < panels.size(); ++p) {
+    const PanelScript panel = panelScript(panels[p], "p" + std::to_string(p) + "s");
+    s += panel.data;
+    body += panel.commands;
+    width += panels[p].width;
+    height = std::max(height, panels[p].height);
+  }
+  if (panels.size() > 1) body = "set multiplot layout 1," + std::to_string(panels.size()) + "\n" + body + "unset multiplot\n";
+  const std::string size = std::to_string(width) + "," + std::to_string(height);
   s += "set terminal pngcairo noenhanced size " + size + " background rgb 'white' font 'sans,10'\nset output " +
-       quoted(png_partial.string()) + "\n" + plot + "\n";
+       quoted(png_partial.string()) + "\n" + body;
   s += "set terminal svg noenhanced size " + size + " dynamic background rgb 'white' font 'sans,12'\nset output " +
-       quoted(svg_partial.string()) + "\nreplot\nunset output\n";
+       quoted(svg_partial.string()) + "\n" + body + "unset output\n";
   return s;
 }
 
@@ -129,12 +156,12 @@ int runGnuplot(const std::string& program, const fs::path& script_file, const fs
 
 }  // namespace
 
-void drawPlotWithGnuplot(const PlotSpec& spec, const fs::path& png, const std::string& program) {
+void drawPlotWithGnuplot(const std::vector<PlotSpec>& panels, const fs::path& png, const std::string& program) {
   fs::path svg = png;
   svg.replace_extension(".svg");
   const fs::path png_partial = png.string() + ".partial", svg_partial = svg.string() + ".partial";
   const fs::path script_file = scratch(".gp"), said = scratch(".txt");
-  writeAtomically(script_file, script(spec, png_partial, svg_partial));
+  writeAtomically(script_file, script(panels, png_partial, svg_partial));
   const int status = runGnuplot(program, script_file, said);
   std::ifstream in(said);
   std::string message{std::istreambuf_iterator<char>(in), {}};

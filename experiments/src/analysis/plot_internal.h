@@ -4,6 +4,7 @@
 // ranges from axisRange, so a plot covers the same data either way. Internal.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "analysis/plot.h"
 
@@ -24,11 +25,14 @@ bool drawable(const PlotSpec& spec, double x, double y);
 /// "gnuplot" when it is on the PATH; "" when there is none.
 std::string gnuplotProgram();
 
-/// Draws with gnuplot: png and the SVG beside it, each written to "<file>.partial" and
-/// renamed. Throws std::runtime_error naming the plot and gnuplot's message when it fails.
-void drawPlotWithGnuplot(const PlotSpec& spec, const std::filesystem::path& png, const std::string& program);
+/// Draws the panels side by side with gnuplot: png and the SVG beside it, each written
+/// to "<file>.partial" and renamed. Throws std::runtime_error naming the plot and
+/// gnuplot's message when it fails.
+void drawPlotWithGnuplot(const std::vector<PlotSpec>& panels, const std::filesystem::path& png,
+                         const std::string& program);
 
-/// Draws with OpenCV: png only (atomically); log axes as log10 of the values.
-void drawPlotWithOpenCv(const PlotSpec& spec, const std::filesystem::path& png);
+/// Draws the panels side by side with OpenCV: png only (atomically); log axes as log10
+/// of the values.
+void drawPlotWithOpenCv(const std::vector<PlotSpec>& panels, const std::filesystem::path& png);
 
 }  // namespace rocklab::experiments::detail

@@ -119,9 +119,8 @@ PlotSpec withLogAxesAsLog10(PlotSpec spec) {
   return spec;
 }
 
-}  // namespace
-
-void drawPlotWithOpenCv(const PlotSpec& logged, const std::filesystem::path& png) {
+/// One panel as an image of its own size.
+cv::Mat drawPanel(const PlotSpec& logged) {
   const PlotSpec spec = withLogAxesAsLog10(logged);
 
   // Layout: margins for the title (top), tick labels and axis labels (left, bottom).
@@ -209,6 +208,22 @@ void drawPlotWithOpenCv(const PlotSpec& logged, const std::filesystem::path& png
     }
   }
 
+  return img;
+}
+
+}  // namespace
+
+void drawPlotWithOpenCv(const std::vector<PlotSpec>& panels, const std::filesystem::path& png) {
+  int height = 0;
+  for (const PlotSpec& spec : panels) height = std::max(height, spec.height);
+  std::vector<cv::Mat> row;
+  for (const PlotSpec& spec : panels) {
+    cv::Mat panel = drawPanel(spec);
+    if (panel.rows < height) cv::copyMakeBorder(panel, panel, 0, height - panel.rows, 0, 0, cv::BORDER_CONSTANT, kWhite);
+    row.push_back(panel);
+  }
+  cv::Mat img;
+  cv::hconcat(row, img);
   render::writePng(png, img);  // atomic: "<png>.partial", then rename
 }
 

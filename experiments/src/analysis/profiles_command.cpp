@@ -170,6 +170,23 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     }
     plots.emplace_back(o.out_dir / ("profile_column_" + std::to_string(column) + ".png"), spec);
   }
+  // The columns side by side on one velocity axis (a zone each in the zoned chute):
+  // how the profiles differ between columns reads at a glance.
+  std::vector<PlotSpec> row;
+  double v_lo = INFINITY, v_hi = -INFINITY;
+  for (const auto& [png, spec] : plots)
+    for (const PlotSeries& s : spec.series)
+      for (const double v : s.x)
+        if (std::isfinite(v)) v_lo = std::min(v_lo, v), v_hi = std::max(v_hi, v);
+  for (const auto& [column, d] : distance_m) {
+    PlotSpec panel = plots[row.size()].second;
+    panel.title = "column " + std::to_string(column) + ", " + std::to_string(std::lround(d * 1e3)) +
+                  " mm from the outlet (DEM truth)";
+    if (v_hi > v_lo) panel.x_range = std::pair{v_lo - 0.05 * (v_hi - v_lo), v_hi + 0.05 * (v_hi - v_lo)};
+    panel.width = 560;
+    panel.height = 520;
+    row.push_back(std::move(panel));
+  }
   PlotSpec discharge;
   discharge.title = "discharged mass after the gate opened";
   discharge.x_label = "time after the gate opened (s)";
@@ -187,6 +204,7 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     detail::writeAtomically(o.out_dir / "profiles.csv", csv.str());
     detail::writeAtomically(o.out_dir / "profiles.json", detail::jsonText({{"runs", table}}));
     for (const auto& [png, spec] : plots) writePlot(spec, png);
+    if (row.size() > 1) writePlotRow(row, o.out_dir / "profiles.png");
   } catch (const std::exception& e) {
     err << "error: profiles: " << e.what() << '\n';
     return kExitFailed;
@@ -204,7 +222,8 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     out << '\n';
   }
   out << "wrote " << (o.out_dir / "profiles.csv").string() << ", profiles.json, " << distance_m.size()
-      << " profile_column_N.png and discharge.png\n";
+      << " profile_column_N.png" << (distance_m.size() > 1 ? ", profiles.png (the columns side by side)" : "")
+      << " and discharge.png\n";
   return 0;
 }
 
