@@ -268,3 +268,36 @@ TEST_CASE("render re-renders a stored run from another camera", "[cli]") {
   CHECK(cli({"render", (out / "nothing.h5").string(), "--camera", camera.string()}) == 2);
   CHECK(cli({"render", (out / "run.h5").string()}) == 2);
 }
+
+TEST_CASE("run and restart film with the cameras of a --camera file, recorded in the run's scene, and a bad file is "
+          "refused by name with nothing written",
+          "[cli]") {
+  const fs::path out = tempDir("film");
+  fs::create_directories(out);
+  std::ofstream(out / "top.toml") << "[[cameras]]\nname = \"top\"\nresolution = [160, 120]\nfov_deg = 60.0\n"
+                                     "eye = [0.0, 0.0, 1.5]\ntarget = [0.0, 0.0, 0.3]\nup = [1.0, 0.0, 0.0]\n"
+                                     "frame_rate = 1000.0\nstill_interval = 0.002\nmovie = false\n";
+  const std::vector<std::string> base{"--quiet", "--set", "scene.end_time=0.004", "--set", "particles.0.count=100",
+                                      "--camera", (out / "top.toml").string()};
+  std::vector<std::string> args{"run", kScene, "--out", (out / "first").string(), "--set", "output.checkpoint=true"};
+  args.insert(args.end(), base.begin(), base.end());
+  REQUIRE(cli(args) == 0);
+  CHECK(fs::exists(out / "first" / "top_still_000000.png"));
+  CHECK(fs::exists(out / "first" / "top_still_000001.png"));
+  const nlohmann::json r = nlohmann::json::parse(slurp(out / "first" / "results.json"));
+  REQUIRE(r["cameras"].size() == 1);
+  // The checkpoint's scene has the camera: a restart films on without --camera.
+  REQUIRE(cli({"restart", (out / "first" / "checkpoint.h5").string(), "--out", (out / "second").string(), "--quiet",
+               "--set", "scene.end_time=0.008"}) == 0);
+  CHECK(fs::exists(out / "second" / "top_still_000001.png"));  // at 0.006 and 0.008 s: a run numbers its own
+  CHECK(nlohmann::json::parse(slurp(out / "second" / "results.json"))["cameras"].size() == 1);
+  // Bad files: a key cameras do not have, a file that is not there; exit 2, no output folder.
+  std::ofstream(out / "bad.toml") << "[[cameras]]\nname = \"x\"\nzoom = 2\n";
+  for (const fs::path& camera : {out / "bad.toml", out / "missing.toml"}) {
+    const auto [code, said] = cliStderr({"run", kScene, "--out", (out / "bad").string(), "--camera", camera.string()});
+    CHECK(code == 2);
+    CHECK_THAT(said, Catch::Contains("--camera") && Catch::Contains(camera.string()));
+    CHECK_FALSE(fs::exists(out / "bad"));
+  }
+  fs::remove_all(out);
+}

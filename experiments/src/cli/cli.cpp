@@ -176,6 +176,7 @@ namespace {
 /// Everything the command line can set: CLI11 fills it, the commands read it.
 struct CliArgs {
   std::string scene_arg, checkpoint_arg, run_file_arg, out_dir, camera_file, collect_dir;
+  std::string film_camera_file;  // --camera of run, restart, demo, study, calibrate-bonds
   std::string weibull_column = "strength_MPa", group_by, size_column;
   std::vector<std::string> overrides;
   int threads = 0;
@@ -227,6 +228,9 @@ void addRunOptions(CLI::App* c, CliArgs& a) {
   c->add_option("--set", a.overrides, "Override a scene key, e.g. --set timestep.dt=1e-6 (TOML value)")
       ->take_all();
   c->add_option("--threads", a.threads, "OpenMP threads (default: all cores)")->check(kCountRange);
+  c->add_option("--camera", a.film_camera_file,
+                "Film the run with the [[cameras]] of this TOML file instead of the scene's (a chute's camera "
+                "named by experiment.track_camera is tracked); e.g. a checkpoint's flow through the lab's camera");
   c->add_flag("--quiet", a.quiet,
               "Print only errors and warnings (no set-up lines, time-step audit, progress or summary)");
 }
@@ -613,6 +617,16 @@ int runCliUnguarded(int argc, const char* const* argv, std::string& name) {
   }
   if (const auto subcommands = app.get_subcommands(); !subcommands.empty()) name = "rocklab " + subcommands.front()->get_name();
 
+  // --camera FILE: the file's cameras as one more --set, so that the run's scene text,
+  // its checkpoint and a set's run lines carry them like any override.
+  if (!a.film_camera_file.empty()) {
+    try {
+      a.overrides.push_back(cameraFileOverride(a.film_camera_file));
+    } catch (const SceneError& e) {
+      std::cerr << "error: --camera: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
   if (app.got_subcommand("list")) return doList();
   if (app.got_subcommand("crusher-geometry"))
     return runCrusherGeometry({a.scene_arg, a.overrides, a.out_dir}, std::cout, std::cerr);

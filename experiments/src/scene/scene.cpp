@@ -205,6 +205,18 @@ std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
   return cameras;
 }
 
+std::string cameraFileOverride(const std::filesystem::path& path) {
+  loadCameras(path);  // every key checked, messages naming the file
+  const toml::table table =
+      parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
+  std::ostringstream text;
+  text << *table["cameras"].as_array();  // inline tables, one a line
+  std::string line;
+  for (const char c : text.str())
+    if (c != '\n') line += c;  // a line break inside a value is written escaped
+  return "cameras=" + line;
+}
+
 std::filesystem::path builtinSceneDir() {
   return std::filesystem::path(ROCKLAB_ASSET_DIR) / "scenes";
 }

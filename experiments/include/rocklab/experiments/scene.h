@@ -158,6 +158,10 @@ Scene loadSceneText(const std::string& text, const std::string& source_name,
 
 /// Reads the [[cameras]] tables of a camera file (the same keys as in a scene).
 std::vector<CameraSettings> loadCameras(const std::filesystem::path& path);
+/// The --set assignment that gives a scene the [[cameras]] of a camera file in place of
+/// its own ("cameras=[{...}]"): how `--camera FILE` films a run of any scene or
+/// checkpoint. The file is checked as loadCameras checks it (SceneError naming it).
+std::string cameraFileOverride(const std::filesystem::path& path);
 
 /// Directory of the built-in scenes, and the resolution of a bare name ("pour")
 /// to a file in it.
