@@ -176,7 +176,7 @@ namespace {
 /// Everything the command line can set: CLI11 fills it, the commands read it.
 struct CliArgs {
   std::string scene_arg, checkpoint_arg, run_file_arg, out_dir, camera_file, collect_dir;
-  std::string film_camera_file;  // --camera of run, restart, demo, study, calibrate-bonds
+  std::string film_camera_file;  // --camera of run, demo, restart, sweep, calibrate, study, calibrate-bonds
   std::string weibull_column = "strength_MPa", group_by, size_column;
   std::vector<std::string> overrides;
   int threads = 0;
