@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <chrono>
 #include <csignal>
@@ -291,6 +292,12 @@ TEST_CASE("run and restart film with the cameras of a --camera file, recorded in
                "--set", "scene.end_time=0.008"}) == 0);
   CHECK(fs::exists(out / "second" / "top_still_000001.png"));  // at 0.006 and 0.008 s: a run numbers its own
   CHECK(nlohmann::json::parse(slurp(out / "second" / "results.json"))["cameras"].size() == 1);
+  // A set's run lines carry the cameras as one --set each, on one line.
+  REQUIRE(cli({"sweep", kScene, "--vary", "scene.seed=1,2", "--camera", (out / "top.toml").string(), "--plan",
+               (out / "plan").string()}) == 0);
+  const std::string lines = slurp(out / "plan" / "runs.txt");
+  CHECK(std::count(lines.begin(), lines.end(), '\n') == 2);
+  CHECK_THAT(lines, Catch::Contains("--set 'cameras=[{ ") && Catch::Contains("name = '\\''top'\\''"));
   // Bad files: a key cameras do not have, a file that is not there; exit 2, no output folder.
   std::ofstream(out / "bad.toml") << "[[cameras]]\nname = \"x\"\nzoom = 2\n";
   for (const fs::path& camera : {out / "bad.toml", out / "missing.toml"}) {

@@ -211,9 +211,12 @@ std::string cameraFileOverride(const std::filesystem::path& path) {
       parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
   std::ostringstream text;
   text << *table["cameras"].as_array();  // inline tables, one a line
-  std::string line;
-  for (const char c : text.str())
-    if (c != '\n') line += c;  // a line break inside a value is written escaped
+  std::string line;  // one line: a line break inside a value is written escaped
+  bool indent = false;
+  for (const char c : text.str()) {
+    if (c == '\n') indent = true;
+    else if (!(indent && c == ' ')) line += c, indent = false;
+  }
   return "cameras=" + line;
 }
 
