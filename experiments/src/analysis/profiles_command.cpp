@@ -149,6 +149,8 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
 
   // One plot a column: velocity against starting height, a series a run (same colour in every plot).
   std::vector<std::pair<std::filesystem::path, PlotSpec>> plots;
+  std::vector<PlotSpec> row;  // profiles.png's panels
+  double v_lo = INFINITY, v_hi = -INFINITY;
   for (const auto& [column, d] : distance_m) {
     PlotSpec spec;
     spec.title = "markers of column " + std::to_string(column) + " (" + std::to_string(std::lround(d * 1e3)) +
@@ -169,24 +171,19 @@ int runProfilesCommand(const RunComparisonOptions& o, std::ostream& out, std::os
       spec.series.push_back(s);
     }
     plots.emplace_back(o.out_dir / ("profile_column_" + std::to_string(column) + ".png"), spec);
-  }
-  // The columns side by side on one velocity axis (a zone each in the zoned chute):
-  // how the profiles differ between columns reads at a glance.
-  std::vector<PlotSpec> row;
-  double v_lo = INFINITY, v_hi = -INFINITY;
-  for (const auto& [png, spec] : plots)
+    // The same column as a panel of profiles.png: the columns side by side on one
+    // velocity axis (a zone each in the zoned chute), how they differ read at a glance.
+    PlotSpec& panel = row.emplace_back(spec);
+    panel.title = "column " + std::to_string(column) + ", " + std::to_string(std::lround(d * 1e3)) +
+                  " mm from the outlet (DEM truth)";
+    panel.width = 560;
+    panel.height = 520;
     for (const PlotSeries& s : spec.series)
       for (const double v : s.x)
         if (std::isfinite(v)) v_lo = std::min(v_lo, v), v_hi = std::max(v_hi, v);
-  for (const auto& [column, d] : distance_m) {
-    PlotSpec panel = plots[row.size()].second;
-    panel.title = "column " + std::to_string(column) + ", " + std::to_string(std::lround(d * 1e3)) +
-                  " mm from the outlet (DEM truth)";
-    if (v_hi > v_lo) panel.x_range = std::pair{v_lo - 0.05 * (v_hi - v_lo), v_hi + 0.05 * (v_hi - v_lo)};
-    panel.width = 560;
-    panel.height = 520;
-    row.push_back(std::move(panel));
   }
+  if (v_hi > v_lo)
+    for (PlotSpec& panel : row) panel.x_range = std::pair{v_lo - 0.05 * (v_hi - v_lo), v_hi + 0.05 * (v_hi - v_lo)};
   PlotSpec discharge;
   discharge.title = "discharged mass after the gate opened";
   discharge.x_label = "time after the gate opened (s)";

@@ -194,9 +194,10 @@ std::string sceneDescription(const std::filesystem::path& path) {
   return table["scene"]["description"].value_or(std::string());
 }
 
-std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
-  const toml::table table =
-      parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
+namespace {
+
+/// The [[cameras]] of a camera file's table, every key checked (SceneError naming the file).
+std::vector<CameraSettings> camerasOf(const toml::table& table, const std::filesystem::path& path) {
   TableReader root(table, "");
   std::vector<CameraSettings> cameras;
   detail::readCameras(root, cameras);
@@ -205,10 +206,19 @@ std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
   return cameras;
 }
 
+toml::table parseCameraFile(const std::filesystem::path& path) {
+  return parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
+}
+
+}  // namespace
+
+std::vector<CameraSettings> loadCameras(const std::filesystem::path& path) {
+  return camerasOf(parseCameraFile(path), path);
+}
+
 std::string cameraFileOverride(const std::filesystem::path& path) {
-  loadCameras(path);  // every key checked, messages naming the file
-  const toml::table table =
-      parseToml(readTomlFile(path, "camera", "give a .toml file with [[cameras]]"), path.string());
+  const toml::table table = parseCameraFile(path);
+  camerasOf(table, path);  // every key checked, messages naming the file
   std::ostringstream text;
   text << *table["cameras"].as_array();  // inline tables, one a line
   std::string line;  // one line: a line break inside a value is written escaped
