@@ -1,6 +1,7 @@
 #include "rocklab/render/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <stdexcept>
 
@@ -97,6 +98,7 @@ struct Renderer::Impl {
     std::vector<double> key = surfaces->opaqueSignature();
     key.insert(key.end(), {frame.background.r, frame.background.g, frame.background.b, view.gain});
     key.insert(key.end(), view.cutPlane.begin(), view.cutPlane.end());
+    key.insert(key.end(), view.cutWedge.begin(), view.cutWedge.end());
     if (key == opaqueKey) return;
     const Framebuffer& layer = multisampled ? *multisampled : *opaque;
     layer.bindForDrawing();
@@ -154,11 +156,15 @@ struct Renderer::Impl {
     view.lighting = {options.ambient, options.diffuse, options.specular, options.shininess};
     view.gain = static_cast<float>(frame.lightGain);
     if (frame.cut) {
-      // The plane in the camera frame: n_c = R n (unit), d = −n_c · (R p + t).
-      const geometry::Vec3 n = camera.rotation * frame.cut->normal.normalized();
-      const double d = -n.dot(camera.rotation * frame.cut->point + camera.translation);
-      view.cutPlane = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()),
-                       static_cast<float>(d)};
+      // A plane in the camera frame: n_c = R n (unit), d = −n_c · (R p + t).
+      const auto inCamera = [&](const geometry::Vec3& normal) {
+        const geometry::Vec3 n = camera.rotation * normal.normalized();
+        const double d = -n.dot(camera.rotation * frame.cut->point + camera.translation);
+        return std::array<float, 4>{static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()),
+                                    static_cast<float>(d)};
+      };
+      view.cutPlane = inCamera(frame.cut->normal);
+      if (frame.cut->wedge_normal) view.cutWedge = inCamera(*frame.cut->wedge_normal);
     }
     surfaces->prepare(frame, camera.rotation, camera.translation);
     updateOpaqueLayer(frame, view);

@@ -107,9 +107,10 @@ uniform vec4 colour;    // rgb, opacity
 uniform vec4 lighting;  // ambient, diffuse, specular, shininess
 uniform float gain;
 uniform vec4 cutPlane;  // camera frame: discarded where dot(n, x) + d > 0; (0, 0, 0, -1) = no cut
+uniform vec4 cutWedge;  // the same, and discarded only where beyond both; (0, 0, 0, 1) = no wedge
 out vec4 fragColour;
 void main() {
-  if (dot(cutPlane.xyz, vCamera) + cutPlane.w > 0.0) discard;
+  if (dot(cutPlane.xyz, vCamera) + cutPlane.w > 0.0 && dot(cutWedge.xyz, vCamera) + cutWedge.w > 0.0) discard;
   // Two-sided; headlight, so n.l = n.v = n.h.
   float ndv = abs(dot(vNormal, normalize(-vCamera)));
   float highlight = max(1.0 - 0.25 * lighting.w * (1.0 - ndv), 0.0);  // x^n, as for spheres

@@ -133,8 +133,8 @@ void SpherePass::upload(const std::vector<SphereInstance>& spheres, const geomet
     for (std::size_t i = n * b / chunks; i < n * (b + 1) / chunks; ++i) {
       const SphereInstance& s = spheres[i];
       const geometry::Vec3 centre = s.centre + dt * s.velocity;
-      // Cut away: a sphere goes whole when its centre lies beyond the plane.
-      if (cut && (centre - cut->point).dot(cut->normal) > 0.0) continue;
+      // Cut away: a sphere goes whole when its centre is in the removed part.
+      if (cut && cut->removes(centre)) continue;
       const geometry::Vec3 c = rotation * centre + translation;
       const double r = s.radius;
       // Not drawn: crossing the near plane (the impostor needs the eye outside), wholly beyond far, outside the sides.

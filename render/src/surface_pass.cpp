@@ -45,7 +45,8 @@ SurfacePass::SurfacePass(const GlApi& gl)
       uColour_(program_.uniform("colour")),
       uLighting_(program_.uniform("lighting")),
       uGain_(program_.uniform("gain")),
-      uCutPlane_(program_.uniform("cutPlane")) {
+      uCutPlane_(program_.uniform("cutPlane")),
+      uCutWedge_(program_.uniform("cutWedge")) {
   gl.GenVertexArrays(1, &polygonVao_);
   gl.GenBuffers(1, &polygonVbo_);
   setAttributes(gl, polygonVao_, polygonVbo_);
@@ -182,6 +183,7 @@ void SurfacePass::drawList(const std::vector<Draw>& draws, const ViewUniforms& v
   gl_.Uniform4f(uLighting_, view.lighting[0], view.lighting[1], view.lighting[2], view.lighting[3]);
   gl_.Uniform1f(uGain_, view.gain);
   gl_.Uniform4f(uCutPlane_, view.cutPlane[0], view.cutPlane[1], view.cutPlane[2], view.cutPlane[3]);
+  gl_.Uniform4f(uCutWedge_, view.cutWedge[0], view.cutWedge[1], view.cutWedge[2], view.cutWedge[3]);
   for (const Draw& d : draws) {
     gl_.UniformMatrix4fv(uCameraFromModel_, 1, GL_FALSE, d.cameraFromModel.data());
     gl_.Uniform4f(uColour_, d.colour[0], d.colour[1], d.colour[2], d.colour[3]);

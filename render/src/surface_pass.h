@@ -65,7 +65,7 @@ class SurfacePass {
 
   const GlApi& gl_;
   Program program_;
-  GLint uCameraFromModel_, uClip_, uColour_, uLighting_, uGain_, uCutPlane_;
+  GLint uCameraFromModel_, uClip_, uColour_, uLighting_, uGain_, uCutPlane_, uCutWedge_;
   GLuint polygonVao_ = 0, polygonVbo_ = 0;
   std::vector<float> polygonVertices_;  // x y z nx ny nz per vertex, camera frame
   std::unordered_map<const geometry::TriangleMesh*, CachedMesh> meshes_;

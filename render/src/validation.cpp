@@ -61,6 +61,8 @@ void validateFrame(const FrameDescription& frame) {
     if (!frame.cut->point.allFinite()) invalidFrame("cut.point", "must be finite");
     if (!frame.cut->normal.allFinite() || !(frame.cut->normal.norm() > 0.0))
       invalidFrame("cut.normal", "must be finite and non-zero");
+    if (frame.cut->wedge_normal && (!frame.cut->wedge_normal->allFinite() || !(frame.cut->wedge_normal->norm() > 0.0)))
+      invalidFrame("cut.wedge_normal", "must be finite and non-zero");
   }
 }
 

@@ -16,9 +16,11 @@ struct ViewUniforms {
   std::array<float, 2> depthMap{};       // z_ndc = depthMap[0] + depthMap[1] / z
   std::array<float, 4> lighting{};       // ambient, diffuse, specular, shininess
   float gain = 1.0f;
-  // The cut-away plane in the camera frame, (n, d) with n unit: a wall fragment at x
-  // with n · x + d > 0 is discarded. (0, 0, 0, -1): no cut.
+  // The cut-away's planes in the camera frame, (n, d) with n unit: a wall fragment at
+  // x with n · x + d > 0 for both is discarded. (0, 0, 0, -1) first: no cut;
+  // (0, 0, 0, 1) second: the first plane alone (CutPlane::removes).
   std::array<float, 4> cutPlane{0.0f, 0.0f, 0.0f, -1.0f};
+  std::array<float, 4> cutWedge{0.0f, 0.0f, 0.0f, 1.0f};
 };
 
 /// Camera → GL for a canvas (derivation in renderer.cpp): OpenCV pixel (u, v)

@@ -101,6 +101,14 @@ TEST_CASE("crusher movie: bad [cameras.cut] keys are refused by name", "[camera]
   // The eye straight above the point (along up): no plane faces the camera unless one is given.
   CHECK_THAT(error({"cameras.chamber.cut.point=[0, -0.85, 0]"}), Contains("cut.normal") && Contains("is needed"));
   CHECK(error({"cameras.chamber.cut.normal=[1, 0, 0]", "cameras.chamber.cut.point=[0.01, 0, 0]"}) == "loaded");
+  // A wedge: a second normal, non-zero and crossing the first plane.
+  CHECK_THAT(error({"cameras.chamber.cut.wedge_normal=[0, 0, 0]"}), Contains("cut.wedge_normal") && Contains("non-zero"));
+  CHECK_THAT(error({"cameras.chamber.cut.wedge_normal=[0, 2, 0]"}),
+             Contains("cut.wedge_normal") && Contains("parallel"));  // the default normal is (0, -1, 0)
+  const Scene wedge = loadScene(kMovieScene, {"cameras.chamber.cut.wedge_normal=[-3, 0, 0]"});
+  REQUIRE(wedge.cameras[0].cut->wedge_normal);
+  CHECK((*wedge.cameras[0].cut->wedge_normal - Vec3(-1, 0, 0)).norm() < 1e-15);
+  CHECK_FALSE(loadScene(kMovieScene).cameras[0].cut->wedge_normal);
 }
 
 TEST_CASE("crusher movie: a short crusher run with the cut-away camera writes its frames, stills and movie",

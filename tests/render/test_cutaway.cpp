@@ -58,7 +58,7 @@ enum class Seen { Box, Wall, Background };
 Seen seen(const Camera& camera, double u, double v, const std::optional<CutPlane>& cut) {
   const Vec3 eye = camera.position();
   const Vec3 d = camera.pixelRay(Vec2(u, v));
-  const auto kept = [&](double t) { return !cut || (eye + t * d - cut->point).dot(cut->normal) <= 0.0; };
+  const auto kept = [&](double t) { return !cut || !cut->removes(eye + t * d); };
   if (const auto hits = boxHits(eye, d); hits && (kept(hits->first) || kept(hits->second))) return Seen::Box;
   const double tWall = (0.3 - eye.y()) / d.y();
   return tWall > 0 && kept(tWall) ? Seen::Wall : Seen::Background;
@@ -136,6 +136,45 @@ TEST_CASE("a cut-away removes the walls beyond its plane, pixel for pixel as a r
   CHECK(cv::norm(again, cutImage, cv::NORM_INF) > 0);
 }
 
+TEST_CASE("a wedge cut-away removes only what lies beyond both planes, pixel for pixel as a ray cast",
+          "[render][cutaway]") {
+  const Camera camera = smallSceneCamera(320, 240);
+  Renderer renderer(camera);
+  FrameDescription frame = boxScene();
+  const int wholeBox = compare(renderer.render(frame), camera, std::nullopt).box;
+
+  // The front-left quarter of the box (x < 0 and y < 0, towards the camera at
+  // x = 0.1, y = -0.6) goes; the plane x = 0 alone would take the whole left half.
+  CutPlane half;
+  half.point = Vec3(0.0, 0.0, 0.03);
+  half.normal = Vec3(-2.0, 0.0, 0.0);  // any length
+  CutPlane quarter = half;
+  quarter.wedge_normal = Vec3(0.0, -1.0, 0.0);
+  CHECK(quarter.removes(Vec3(-0.01, -0.01, 0.05)));
+  CHECK_FALSE(quarter.removes(Vec3(-0.01, 0.01, 0.05)));  // beyond the first plane only
+  CHECK_FALSE(quarter.removes(Vec3(0.01, -0.01, 0.05)));  // beyond the second only
+  CHECK(half.removes(Vec3(-0.01, 0.01, 0.05)));
+
+  frame.cut = quarter;
+  const cv::Mat quarterImage = renderer.render(frame);
+  const Comparison wedge = compare(quarterImage, camera, quarter);
+  CHECK(wedge.mismatches == 0);
+  frame.cut = half;
+  const cv::Mat halfImage = renderer.render(frame);
+  const Comparison halved = compare(halfImage, camera, half);
+  CHECK(halved.mismatches == 0);
+  // The quarter takes box pixels (the inner faces of the back-left show where the
+  // front-left was), and the wall behind the kept back-left quarter stays: fewer
+  // background pixels than the half-space cut leaves.
+  CHECK(wedge.box > 1000);
+  CHECK(cv::norm(quarterImage, halfImage, cv::NORM_INF) > 0);
+  CHECK(wedge.background < halved.background);
+  CHECK(wholeBox > wedge.box - 1);
+  // The wall y = 0.3 lies beyond the first plane only where x < 0, never beyond the
+  // second: the wedge leaves all of it, so nothing black shows.
+  CHECK(wedge.background == 0);
+}
+
 TEST_CASE("a cut-away drops the spheres whose centre lies beyond the plane and shows what they hid", "[render][cutaway]") {
   const Camera camera = smallSceneCamera(320, 240);
   const Vec3 eye = camera.position();
@@ -190,13 +229,22 @@ TEST_CASE("a cut-away drops the spheres whose centre lies beyond the plane and s
       red += p[2] > p[1] + 40 && p[2] > p[0] + 40;
     }
   CHECK(red == 0);
+
+  // With a wedge normal for which the near sphere's centre is not beyond, it stays.
+  cut.wedge_normal = side + 0.1 * view;  // the near centre lies 0.015 m short of the second plane
+  REQUIRE_FALSE(cut.removes(nearCentre));
+  frame.cut = cut;
+  const cv::Vec3b kept = pixel(renderer.render(frame));
+  CHECK(kept[2] > kept[0] + 60);  // red again
 }
 
 TEST_CASE("a cut-away with a zero or non-finite normal is refused", "[render][cutaway]") {
   Renderer renderer(smallSceneCamera(320, 240));
   FrameDescription frame = boxScene();
-  frame.cut = CutPlane{Vec3::Zero(), Vec3::Zero()};
+  frame.cut = CutPlane{Vec3::Zero(), Vec3::Zero(), std::nullopt};
   CHECK_THROWS_WITH(renderer.render(frame), Catch::Contains("frame.cut.normal"));
-  frame.cut = CutPlane{Vec3(std::nan(""), 0, 0), Vec3::UnitX()};
+  frame.cut = CutPlane{Vec3(std::nan(""), 0, 0), Vec3::UnitX(), std::nullopt};
   CHECK_THROWS_WITH(renderer.render(frame), Catch::Contains("frame.cut.point"));
+  frame.cut = CutPlane{Vec3::Zero(), Vec3::UnitX(), Vec3::Zero()};
+  CHECK_THROWS_WITH(renderer.render(frame), Catch::Contains("frame.cut.wedge_normal"));
 }

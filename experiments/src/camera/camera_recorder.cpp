@@ -92,6 +92,7 @@ void CameraRecorder::finish(nlohmann::json& cameras) {
     const auto& p = settings_.cut->point;
     const auto& n = settings_.cut->normal;
     c["cut"] = {{"point_m", {p.x(), p.y(), p.z()}}, {"normal", {n.x(), n.y(), n.z()}}};
+    if (const auto& w = settings_.cut->wedge_normal) c["cut"]["wedge_normal"] = {w->x(), w->y(), w->z()};
   }
   if (movie_) {
     const std::filesystem::path path = movie_->close();

@@ -25,7 +25,8 @@ std::string sceneKeyOf(const std::string& message) {
 
 /// [cameras.cut]: the cut-away plane. By default the plane through the camera's
 /// target facing the camera across `up` (a vertical plane when up is vertical),
-/// removing the half of the scene nearest the camera.
+/// removing the half of the scene nearest the camera; with `wedge_normal` a second
+/// plane through the same point, and only what lies beyond both goes (a wedge).
 render::CutPlane readCut(TableReader& t, const Vec3& eye, const Vec3& target, const Vec3& up) {
   render::CutPlane cut;
   cut.point = t.vec3("point", target);
@@ -38,6 +39,15 @@ render::CutPlane readCut(TableReader& t, const Vec3& eye, const Vec3& target, co
   cut.normal = t.vec3("normal", facing ? Vec3(towards.normalized()) : Vec3::UnitX());
   if (!(cut.normal.norm() > 0)) t.fail("normal", "must be non-zero");
   cut.normal.normalize();
+  if (t.has("wedge_normal")) {
+    Vec3 wedge = t.requiredVec3("wedge_normal");
+    if (!(wedge.norm() > 0)) t.fail("wedge_normal", "must be non-zero");
+    wedge.normalize();
+    // Parallel normals remove a half-space again, opposite ones nothing: a typing slip.
+    if (std::abs(wedge.dot(cut.normal)) > 1.0 - 1e-9)
+      t.fail("wedge_normal", "must not be parallel to normal (the two planes make a wedge only when they cross)");
+    cut.wedge_normal = wedge;
+  }
   t.finish();
   return cut;
 }

@@ -252,9 +252,10 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"cameras", "ambient", "", "Light from all sides, as a fraction of a material's colour (a sizing station's dome light: high ambient, low diffuse)."},
       {"cameras", "diffuse", "", "The lamp at the camera: diffuse fraction of a material's colour (a sphere darkens towards its outline)."},
       {"cameras", "specular", "", "The lamp's white highlight (Blinn-Phong)."},
-      {"cameras.cut", "", "", "A cut-away: what lies beyond a plane is not drawn, so the inside of a closed chamber shows. Walls are clipped per pixel (their cut edges and inner faces show); a ball is dropped whole when its centre lies beyond the plane. An empty table cuts along the vertical plane through target that faces the camera (docs/camera.md)."},
+      {"cameras.cut", "", "", "A cut-away: what lies beyond a plane is not drawn, so the inside of a closed chamber shows. Walls are clipped per pixel (their cut edges and inner faces show); a ball is dropped whole when its centre lies beyond the plane. An empty table cuts along the vertical plane through target that faces the camera. With wedge_normal only what lies beyond both planes goes: a quarter cut-away (docs/camera.md)."},
       {"cameras.cut", "point", "m", "A point on the cut plane.", nullptr, "target"},
       {"cameras.cut", "normal", "", "Normal of the plane, pointing into the half that is removed (any length).", nullptr, "from point towards eye, its part along up removed (the half nearest the camera goes)"},
+      {"cameras.cut", "wedge_normal", "", "Normal of a second plane through point, pointing into its removed half (any length, not parallel to normal): only what lies beyond both planes is removed, a wedge; perpendicular normals remove a quarter, which shows two sections and the surfaces between them.", nullptr, "none (the first plane alone)"},
 
       // --- [experiment]
       {"experiment", "", "", "The experiment type and the keys every type has; the other keys depend on the type (tables below)."},
@@ -574,6 +575,10 @@ light_gain = 1
 ambient = 0.35
 diffuse = 0.65
 specular = 0.2
+[cameras.cut]
+point = [0, 0, 0]
+normal = [-1, 0, 0]
+wedge_normal = [0, -1, 0]
 [output]
 frame_interval = 0
 energy_interval = 0

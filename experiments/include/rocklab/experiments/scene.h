@@ -97,8 +97,9 @@ struct CameraSettings {
   // a sizing station's dome) and the lamp at the camera (diffuse, and the white
   // specular highlight); render::RenderOptions' defaults.
   double ambient = 0.35, diffuse = 0.65, specular = 0.20;
-  // A cut-away ([cameras.cut]): what lies beyond the plane is not drawn (walls
-  // clipped per pixel, balls whose centre is beyond dropped); none by default.
+  // A cut-away ([cameras.cut]): what lies beyond the plane (beyond both planes, with
+  // a wedge_normal) is not drawn (walls clipped per pixel, balls whose centre is
+  // in the removed part dropped); none by default.
   std::optional<render::CutPlane> cut;
 };
 

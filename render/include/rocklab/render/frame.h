@@ -61,9 +61,20 @@ struct MeshInstance {
 /// and transparent) are clipped per pixel, so a cut shell shows its cut edge and its
 /// inner face; a sphere is dropped whole when its centre lies beyond the plane (a ball
 /// is shown entire or not at all, as a DEM post-processor's half-space selection).
+/// With a wedge normal a second plane through the same point joins it and only what
+/// lies beyond both is removed: a wedge, a quarter when the two normals are
+/// perpendicular (the engineer's cut-away, which shows two sections and the
+/// surfaces between them).
 struct CutPlane {
   Vec3 point = Vec3::Zero();     // m, world: a point on the plane
   Vec3 normal = Vec3::UnitZ();   // world, any length > 0: points into the removed half-space
+  std::optional<Vec3> wedge_normal;  // world, any length > 0: the second plane's, through point
+
+  /// Whether x is removed: beyond the plane, and beyond the second one if any.
+  bool removes(const Vec3& x) const {
+    const Vec3 r = x - point;
+    return r.dot(normal) > 0.0 && (!wedge_normal || r.dot(*wedge_normal) > 0.0);
+  }
 };
 
 struct FrameDescription {

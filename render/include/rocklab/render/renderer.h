@@ -15,8 +15,9 @@
 //      hidden behind nearer spheres are dropped on the CPU first;
 //   3. transparent polygons and meshes (opacity < 1, the Perspex), far to near,
 //      depth tested, no depth writes.
-// A cut-away (FrameDescription::cut) discards wall pixels beyond its plane in the
-// surface shader and drops the spheres whose centre lies beyond it before culling.
+// A cut-away (FrameDescription::cut) discards wall pixels beyond its plane (beyond
+// both, for a wedge) in the surface shader and drops the spheres whose centre lies
+// in the removed part before culling.
 // Lighting: Blinn–Phong with a headlight at the camera plus ambient.
 // Lens distortion (camera k1, k2): the scene is rendered undistorted on a canvas
 // large enough for the distorted field of view, then warped with cv::remap, so
