@@ -96,7 +96,7 @@ void World::Impl::doStep(const std::function<void(const Snapshot&)>& observer) {
     integrateStage(plan, checks);  // 8
     finishStep(checks);
   }
-  if (team_policy == TeamPolicy::Adaptive && fullTeam() > 1) {
+  if (team_policy == TeamPolicy::Adaptive && teamToChoose()) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - observer_seconds;
     if (tuner.stepDone(seconds)) teamChanged();

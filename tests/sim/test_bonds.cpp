@@ -383,7 +383,7 @@ TEST_CASE("bond: bitwise the same on one and two threads while bonds break", "[b
 
 TEST_CASE("bond: a world too small for two threads runs its many bonds on two, bitwise the same",
           "[bonds]") {
-  // 1,900 balls (one thread: fewer than 2,000) and 5,491 bonds (two: 2,000 a thread).
+  // 1,900 balls (one thread: fewer than 2,000) and 5,491 bonds (two: 500 a thread).
   const BreakingRows scene(19, 100, 3);
   REQUIRE(scene.spheres.size() < 2000);
   REQUIRE(scene.bonds.size() >= 4000);
@@ -396,6 +396,13 @@ TEST_CASE("bond: a world too small for two threads runs its many bonds on two, b
   CHECK(one.hash == two.hash);
   CHECK(one.broken == two.broken);
   CHECK(one.broken.size() > 10);
+  // One thread chosen (by the policy here, by the adaptive team's timing beside a
+  // busy process) takes the bond stage to one thread as well.
+  sim::World world(scene.model, scene.spheres, {}, scene.bonds, 2);
+  world.setTeamPolicy(sim::TeamPolicy::Single);
+  CHECK(world.bondThreads() == 1);
+  world.setTeamPolicy(sim::TeamPolicy::Full);
+  CHECK(world.bondThreads() == two.bond_threads);
 }
 
 TEST_CASE("bond: restart from a checkpoint with broken bonds equals the uninterrupted run",
