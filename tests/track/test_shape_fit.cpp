@@ -126,6 +126,49 @@ TEST_CASE("the shape fit recovers a rendered clump's image position and depth, a
                                        << 1e3 * worst_depth << " mm");
 }
 
+TEST_CASE("among several marker shapes the fit picks the rendered clump's and recovers its position",
+          "[track][shape-fit]") {
+  // The demo clump at 0.7, 1 and 1.3 times its size (the zoned chute's markers are
+  // clumps of three sizes), each rendered against the wall in two poses.
+  const Camera camera = demoCamera();
+  std::vector<ShapeFitter> fitters;
+  for (double scale : {0.7, 1.0, 1.3}) {
+    MarkerModel m = clumpModel();
+    m.balls = geometry::fourBallClump(scale * kMemberRadius);
+    fitters.emplace_back(camera, m);
+  }
+  render::Renderer renderer(camera);
+  DetectorSettings detector;
+  detector.edge_points = true;
+  const Eigen::Quaterniond flat = turned(90, Vec3::UnitX());
+  const std::vector<Eigen::Quaterniond> poses = {turned(35, Vec3::UnitZ()) * flat,
+                                                 turned(50, Vec3(1, 0, 0.3)) * flat};
+  double worst_px = 0;
+  for (std::size_t shape = 0; shape < fitters.size(); ++shape)
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      INFO("shape " << shape << ", pose " << k);
+      TruePose truth;
+      const cv::Mat image = renderer.render(clumpFrame(fitters[shape], poses[k], 0.15 + 0.2 * k, 0.04, truth));
+      const std::vector<Detection> ds = detectMarkers(image, detector);
+      REQUIRE(ds.size() == 1);
+      const std::optional<ShapeChoice> best = fitBestShape(fitters, ds[0].edge_points, ds[0].centroid);
+      REQUIRE(best);
+      CHECK(best->shape == shape);
+      const geometry::Vec2 p = camera.project(truth.centre);
+      const double error_px = cv::norm(best->pose.pixel - cv::Point2d(p.x(), p.y()));
+      worst_px = std::max(worst_px, error_px);
+      CHECK(error_px < 0.25);
+      // The other shapes fit the outline worse: their residual is at least twice the chosen one's.
+      for (std::size_t other = 0; other < fitters.size(); ++other) {
+        if (other == shape) continue;
+        const std::optional<MarkerPose> wrong = fitters[other].fit(ds[0].edge_points, ds[0].centroid);
+        if (wrong) CHECK(wrong->rms_px > 2 * best->pose.rms_px);
+      }
+    }
+  WARN("several shapes: worst image error " << worst_px << " px");
+  CHECK_FALSE(fitBestShape({}, {}, {0, 0}));
+}
+
 TEST_CASE("shape fit settings and marker models are checked", "[track][shape-fit]") {
   ShapeFitSettings s;
   s.robust_px = 0;

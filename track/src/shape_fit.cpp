@@ -384,6 +384,16 @@ std::optional<MarkerPose> ShapeFitter::fit(const std::vector<cv::Point2f>& all_e
   return best;
 }
 
+std::optional<ShapeChoice> fitBestShape(const std::vector<ShapeFitter>& fitters, const std::vector<cv::Point2f>& edges,
+                                        cv::Point2d centroid) {
+  std::optional<ShapeChoice> best;
+  for (std::size_t k = 0; k < fitters.size(); ++k) {
+    const std::optional<MarkerPose> pose = fitters[k].fit(edges, centroid);
+    if (pose && (!best || pose->rms_px < best->pose.rms_px)) best = ShapeChoice{k, *pose};
+  }
+  return best;
+}
+
 void smoothFittedDepths(std::vector<Track>& tracks, const geometry::Camera& camera, const MarkerModel& model,
                         int half_window) {
   const Vec3 n = model.wall_normal.normalized();

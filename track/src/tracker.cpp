@@ -9,15 +9,17 @@ Tracker::Tracker(TrackerSettings settings) : settings_(settings), linker_(settin
   settings_.stitch.validate();
 }
 
-void Tracker::useShapeFit(ShapeFitter fitter) {
-  fitter_.emplace(std::move(fitter));
-  settings_.detector.edge_points = true;
+void Tracker::useShapeFit(ShapeFitter fitter) { useShapeFits({std::move(fitter)}); }
+
+void Tracker::useShapeFits(std::vector<ShapeFitter> fitters) {
+  fitters_ = std::move(fitters);
+  settings_.detector.edge_points = !fitters_.empty();
 }
 
 void Tracker::add(int frame, double time, const cv::Mat& bgr) {
   const std::vector<Detection> detections = detectMarkers(bgr, settings_.detector, linker_.predictions(frame, time));
   linker_.add(frame, time, detections);
-  if (!fitter_) return;
+  if (fitters_.empty()) return;
   // A seed older than the linker's reach (the marker was hidden) is still the best
   // guess of the orientation; the fit judges it by its residual.
   const std::vector<int> ids = linker_.lastTrackIds();
@@ -27,9 +29,21 @@ void Tracker::add(int frame, double time, const cv::Mat& bgr) {
     const int id = ids[i];
     if (id < 0) continue;  // not linked (cannot happen: every detection extends or starts a track)
     const auto seed = seeds_.find(id);
-    const std::optional<MarkerPose> pose =
-        seed == seeds_.end() ? fitter_->fit(d.edge_points, d.centroid)
-                             : fitter_->fit(d.edge_points, d.centroid, &seed->second.pose, seed->second.centroid);
+    std::optional<MarkerPose> pose;
+    std::size_t shape = seed == seeds_.end() ? 0 : seed->second.shape;
+    if (seed != seeds_.end())
+      pose = fitters_[shape].fit(d.edge_points, d.centroid, &seed->second.pose, seed->second.centroid);
+    // A track's first fit, or a seeded one that had to search (the seed fit poorly:
+    // perhaps it had the wrong shape), chooses among several shapes.
+    if (fitters_.size() > 1 && (seed == seeds_.end() || (pose && pose->searched))) {
+      if (const std::optional<ShapeChoice> best = fitBestShape(fitters_, d.edge_points, d.centroid)) {
+        pose = best->pose;
+        shape = best->shape;
+        ++counts_.shape_choices;
+      }
+    } else if (seed == seeds_.end()) {
+      pose = fitters_[0].fit(d.edge_points, d.centroid);
+    }
     if (!pose) {
       ++counts_.unfitted;
       continue;
@@ -37,7 +51,7 @@ void Tracker::add(int frame, double time, const cv::Mat& bgr) {
     ++counts_.fitted;
     if (pose->searched) ++counts_.searched;
     linker_.refineLastPoint(id, pose->pixel, pose->centre);
-    seeds_[id] = {*pose, d.centroid};
+    seeds_[id] = {*pose, d.centroid, shape};
     fitted.emplace_back(id, pose->pixel);
   }
   // One marker fitted twice: the track with fewer points (the younger on a tie)

@@ -78,13 +78,19 @@ void MarkerTracking::setMarkers(double plane_y, double radius) {
   tracker_ = std::make_unique<track::Tracker>(s);
 }
 
-void MarkerTracking::useShapeFit(const std::vector<geometry::Sphere>& balls) {
-  track::MarkerModel model;
-  model.balls = balls;
-  model.wall_point = geometry::Vec3::Zero();
-  model.wall_normal = geometry::Vec3::UnitY();
-  tracker_->useShapeFit(track::ShapeFitter(camera_, model));
-  shape_model_ = model;
+void MarkerTracking::useShapeFit(const std::vector<std::vector<geometry::Sphere>>& shapes) {
+  std::vector<track::ShapeFitter> fitters;
+  for (const std::vector<geometry::Sphere>& balls : shapes) {
+    track::MarkerModel model;
+    model.balls = balls;
+    model.wall_point = geometry::Vec3::Zero();
+    model.wall_normal = geometry::Vec3::UnitY();
+    fitters.emplace_back(camera_, model);
+  }
+  if (fitters.empty()) return;
+  shape_model_ = fitters.front().model();  // the wall, which every shape shares (smoothFittedDepths)
+  shape_count_ = fitters.size();
+  tracker_->useShapeFits(std::move(fitters));
 }
 
 void MarkerTracking::addFrame(std::uint64_t frame, double time, const cv::Mat& bgr) {
@@ -110,6 +116,7 @@ MarkerTracking::Result MarkerTracking::finish() const {
   };
   if (shape_model_) {
     r.shape_fit = true;
+    r.shapes = shape_count_;
     r.shape_fit_counts = tracker_->shapeFitCounts();
     std::vector<track::Track> on_plane = r.tracks;
     for (track::Track& t : on_plane)

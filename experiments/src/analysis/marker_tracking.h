@@ -32,9 +32,10 @@ class MarkerTracking {
   /// stitching gate.
   void setMarkers(double plane_y, double radius);
   /// Model-based marker positions (track/shape_fit.h): the markers are clumps of
-  /// these balls (m, about the centre of mass) touching the camera-side wall
-  /// (y = 0, the bed at y > 0); call after setMarkers.
-  void useShapeFit(const std::vector<geometry::Sphere>& balls);
+  /// these balls (m, about the centre of mass; a shape each, when the markers have
+  /// several: each track takes the one that fits it best) touching the camera-side
+  /// wall (y = 0, the bed at y > 0); call after setMarkers.
+  void useShapeFit(const std::vector<std::vector<geometry::Sphere>>& shapes);
   /// The camera the tracker works with (e.g. the one recovered by calibration);
   /// call before setMarkers.
   void setCamera(const geometry::Camera& camera) { camera_ = camera; }
@@ -51,6 +52,7 @@ class MarkerTracking {
     // marker centres), one per track each.
     std::vector<std::pair<std::string, std::vector<track::MarkerVelocity>>> depth_variants;
     bool shape_fit = false;
+    std::size_t shapes = 0;  // marker shapes the fit chose among
     track::Tracker::ShapeFitCounts shape_fit_counts;
     std::vector<track::StitchJoin> joins;
     std::vector<int> unresolved;                    // track ids (before stitching) left apart
@@ -70,6 +72,7 @@ class MarkerTracking {
   double reference_time_ = std::numeric_limits<double>::quiet_NaN();
   std::unique_ptr<track::Tracker> tracker_;
   std::optional<track::MarkerModel> shape_model_;  // with the shape fit
+  std::size_t shape_count_ = 0;                     // marker shapes fitted
   std::vector<std::pair<int, double>> frames_;
   double seconds_ = 0.0;
 };

@@ -412,10 +412,11 @@ class ChuteExperiment final : public Experiment {
     }
   }
 
-  /// The shape fit needs what the lab knows of its markers: one clump shape, the
-  /// same for all, touching the camera-side wall. The first marker's balls about its
-  /// centre of mass give it; markers of different shapes, or placed off the wall
-  /// (marker_y), keep the centroid (shape_fit_skipped_ says why).
+  /// The shape fit needs what the lab knows of its markers: their clump shapes,
+  /// touching the camera-side wall. Each marker's balls about its centre of mass give
+  /// its shape; markers of several shapes (the zoned chute's three clump sizes) give
+  /// the fit several to choose among, one a track. Markers placed off the wall
+  /// (marker_y) keep the centroid (shape_fit_skipped_ says why).
   void useMarkerShape(const sim::ParticleState& p) {
     if (markers_.empty()) return;
     if (e_.marker_y > 0) {
@@ -433,18 +434,21 @@ class ChuteExperiment final : public Experiment {
       }
       return balls;
     };
-    const std::vector<geometry::Sphere> shape = ballsOf(markers_.front().id);
+    // One shape per set of member radii: the members of one clump type, wherever it
+    // lies, have the same radii in the same order (the offsets turn with the clump).
+    auto sameShape = [](const std::vector<geometry::Sphere>& a, const std::vector<geometry::Sphere>& b) {
+      bool same = a.size() == b.size();
+      for (std::size_t k = 0; same && k < a.size(); ++k)
+        same = std::abs(a[k].radius - b[k].radius) <= 1e-9 * a[k].radius;
+      return same;
+    };
+    std::vector<std::vector<geometry::Sphere>> shapes;
     for (const Marker& m : markers_) {
-      const std::vector<geometry::Sphere> other = ballsOf(m.id);
-      bool same = other.size() == shape.size();
-      for (std::size_t k = 0; same && k < shape.size(); ++k)
-        same = std::abs(other[k].radius - shape[k].radius) <= 1e-9 * shape[k].radius;
-      if (!same) {
-        shape_fit_skipped_ = "the markers are not all the same shape";
-        return;
-      }
+      std::vector<geometry::Sphere> balls = ballsOf(m.id);
+      if (std::none_of(shapes.begin(), shapes.end(), [&](const auto& s) { return sameShape(s, balls); }))
+        shapes.push_back(std::move(balls));
     }
-    tracking_->useShapeFit(shape);
+    tracking_->useShapeFit(shapes);
   }
 
   /// Height of the channel above the base at x: under the top plate, else the bed.
@@ -660,13 +664,16 @@ nlohmann::json ChuteExperiment::reportTracking(nlohmann::json& markers,
                    "Hungarian linking with constant-velocity prediction, tracks stitched across gaps; ") +
            (t.shape_fit ? "position: the marker clump's projected outline fitted to the blob's sub-pixel edges "
                           "(Levenberg-Marquardt, seeded from the track's previous pose, multi-start at a track's "
-                          "first frame or after a poor fit), its depth from the clump touching the camera wall"
+                          "first frame or after a poor fit, where markers of several shapes each shape tried and the "
+                          "smallest edge residual kept), its depth from the clump touching the camera wall"
                         : "position: the centroid, pixel -> world on the plane of the marker centres") +
            "; velocity from 2 mm to measure_distance of travel along the base, as the truth"},
       {"calibration", calibration_report_}};
   if (t.shape_fit)
-    s["shape_fit"] = {{"fitted", t.shape_fit_counts.fitted},
+    s["shape_fit"] = {{"shapes", t.shapes},
+                      {"fitted", t.shape_fit_counts.fitted},
                       {"searched", t.shape_fit_counts.searched},
+                      {"shape_choices", t.shape_fit_counts.shape_choices},
                       {"unfitted", t.shape_fit_counts.unfitted},
                       {"duplicates_withdrawn", t.shape_fit_counts.duplicates}};
   else if (e_.track_position == "shape")

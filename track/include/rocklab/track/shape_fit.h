@@ -110,6 +110,18 @@ class ShapeFitter {
   std::vector<Eigen::Quaterniond> starts_;
 };
 
+/// A blob fitted by the shape of each of several markers (a chute whose markers are
+/// clumps of several sizes): the shape whose fit leaves the smallest edge residual
+/// (MarkerPose::rms_px), and its pose. A wrong shape cannot match the outline at
+/// the depth its contact with the wall fixes, so its residual stays larger.
+struct ShapeChoice {
+  std::size_t shape = 0;  // index into the fitters
+  MarkerPose pose;
+};
+/// Each fitter's fit (fit(), no seed: the multi-start search); empty when none fits.
+std::optional<ShapeChoice> fitBestShape(const std::vector<ShapeFitter>& fitters, const std::vector<cv::Point2f>& edges,
+                                        cv::Point2d centroid);
+
 /// The fitted depths of each track (TrackPoint::centre's distance from the wall)
 /// replaced by their running median over ±half_window points, each centre moved
 /// along its pixel's ray to that depth: a nearly flat clump's tilt, and so its

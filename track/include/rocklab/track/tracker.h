@@ -3,7 +3,8 @@
 // detector's split of merged blobs (detect.h, 4a), the detections are linked
 // (link.h), and with a shape fit (useShapeFit) each linked detection's position
 // becomes the model-based one (shape_fit.h), seeded from its track's pose in the
-// previous frame, and a track whose fit repeats another's ends (one marker's blob
+// previous frame (with several marker shapes, a track's first fit tries each and
+// keeps the best, fitBestShape, and its later fits use that shape), and a track whose fit repeats another's ends (one marker's blob
 // cut in two); at the end, tracks broken by a gap are stitched (stitch.h).
 #include <optional>
 #include <unordered_map>
@@ -33,14 +34,17 @@ class Tracker {
  public:
   explicit Tracker(TrackerSettings settings = {});
   /// Model-based positions from now on: the detector gives edge points, every
-  /// linked detection with enough of them is fitted.
+  /// linked detection with enough of them is fitted, by one marker shape or by the
+  /// best of several (one fitter each).
   void useShapeFit(ShapeFitter fitter);
+  void useShapeFits(std::vector<ShapeFitter> fitters);
   /// One BGR frame; frames and times increase (Linker::add).
   void add(int frame, double time, const cv::Mat& bgr);
 
   struct ShapeFitCounts {
     long fitted = 0;     // detections whose position is the fit's
     long searched = 0;   // of those, fits that ran the multi-start search
+    long shape_choices = 0;  // of those, fits that chose among several shapes
     long unfitted = 0;   // detections left at their centroid (too few edge points, no convergence)
     long duplicates = 0; // detections withdrawn: their fit repeated another track's (duplicate_distance_px)
   };
@@ -55,10 +59,11 @@ class Tracker {
   struct Seed {
     MarkerPose pose;
     cv::Point2d centroid;  // px, the detection's centroid the pose was fitted to
+    std::size_t shape = 0;  // the fitter of the track's shape
   };
   TrackerSettings settings_;
   Linker linker_;
-  std::optional<ShapeFitter> fitter_;
+  std::vector<ShapeFitter> fitters_;  // none: centroids
   std::unordered_map<int, Seed> seeds_;  // by track id: its last fitted pose
   ShapeFitCounts counts_;
 };
