@@ -4,6 +4,7 @@
 // the fit sees only the frame, the camera and the clump's shape.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "rocklab/render/renderer.h"
 #include "rocklab/track/detect.h"
 #include "rocklab/track/shape_fit.h"
+#include "rocklab/track/tracker.h"
 #include "track_scenes.h"
 
 using namespace rocklab;
@@ -167,6 +169,51 @@ TEST_CASE("among several marker shapes the fit picks the rendered clump's and re
     }
   WARN("several shapes: worst image error " << worst_px << " px");
   CHECK_FALSE(fitBestShape({}, {}, {0, 0}));
+}
+
+TEST_CASE("the tracker fits each of two markers of different shapes with its own shape, frame after frame",
+          "[track][shape-fit]") {
+  // A small and a large clump (0.7 and 1.3 times the demo's) moving along the wall
+  // 2 mm a frame, slowly turning; the tracker knows both shapes, not which is which.
+  const Camera camera = demoCamera();
+  std::vector<ShapeFitter> fitters;
+  for (double scale : {0.7, 1.3}) {
+    MarkerModel m = clumpModel();
+    m.balls = geometry::fourBallClump(scale * kMemberRadius);
+    fitters.emplace_back(camera, m);
+  }
+  Tracker tracker;
+  tracker.useShapeFits(fitters);
+  render::Renderer renderer(camera);
+  const Eigen::Quaterniond flat = turned(90, Vec3::UnitX());
+  constexpr int kFrames = 6;
+  std::vector<std::array<cv::Point2d, 2>> truth_px;
+  for (int f = 0; f < kFrames; ++f) {
+    render::FrameDescription frame;
+    std::array<cv::Point2d, 2> px;
+    for (std::size_t k = 0; k < 2; ++k) {
+      TruePose truth;
+      const Eigen::Quaterniond pose = turned(30.0 + 2.0 * f, Vec3(static_cast<double>(k), 0, 1)) * flat;
+      const render::FrameDescription one = clumpFrame(fitters[k], pose, 0.12 + 0.28 * k + 0.002 * f, 0.04, truth);
+      frame.spheres.insert(frame.spheres.end(), one.spheres.begin(), one.spheres.end());
+      const geometry::Vec2 p = camera.project(truth.centre);
+      px[k] = {p.x(), p.y()};
+    }
+    truth_px.push_back(px);
+    tracker.add(f, f / kFrameRate, renderer.render(frame));
+  }
+  const StitchResult result = tracker.finish();
+  REQUIRE(result.tracks.size() == 2);
+  CHECK(tracker.shapeFitCounts().fitted == 2 * kFrames);
+  CHECK(tracker.shapeFitCounts().shape_choices == 2);  // each track's first frame
+  double worst_px = 0;
+  for (const Track& t : result.tracks) {
+    REQUIRE(t.points.size() == kFrames);
+    const std::size_t k = t.points[0].pixel.x < truth_px[0][1].x - 50 ? 0 : 1;  // the left one is the small one
+    for (const TrackPoint& p : t.points) worst_px = std::max(worst_px, cv::norm(p.pixel - truth_px[p.frame][k]));
+  }
+  CHECK(worst_px < 0.25);
+  WARN("tracker with two shapes: worst image error " << worst_px << " px");
 }
 
 TEST_CASE("shape fit settings and marker models are checked", "[track][shape-fit]") {
