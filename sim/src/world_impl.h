@@ -352,10 +352,10 @@ struct World::Impl {
     return std::max(fullTeam(), std::min(threads, useful));
   }
   int bondTeamSize() const { return singleChosen() ? 1 : fullBondTeam(); }
-  // Whether any stage has a team to choose: the tuner then times the step on it
-  // and on one thread (beside a busy process the bonds' second thread made that
-  // crusher 1.5x slower than one thread).
-  bool teamToChoose() const { return std::max(fullTeam(), fullBondTeam()) > 1; }
+  // Whether any stage has a team to choose (the bond team is never smaller than the
+  // ball team): the tuner then times the step on it and on one thread (beside a busy
+  // process the bonds' second thread made that crusher 1.5x slower than one thread).
+  bool teamToChoose() const { return fullBondTeam() > 1; }
   const detail::PairProps& pairProps(std::size_t i, std::size_t j) const {
     return ball_ball[static_cast<std::size_t>(p.material[i]) * nm + static_cast<std::size_t>(p.material[j])];
   }

@@ -33,17 +33,16 @@ void Tracker::add(int frame, double time, const cv::Mat& bgr) {
     std::size_t shape = seed == seeds_.end() ? 0 : seed->second.shape;
     if (seed != seeds_.end())
       pose = fitters_[shape].fit(d.edge_points, d.centroid, &seed->second.pose, seed->second.centroid);
-    // A track's first fit, or a seeded one that had to search (the seed fit poorly:
-    // perhaps it had the wrong shape), chooses among several shapes.
-    if (fitters_.size() > 1 && (seed == seeds_.end() || (pose && pose->searched))) {
+    // A track's first fit searches every shape (one shape: its search); with several,
+    // so does a seeded fit that had to search (the seed fit poorly: perhaps it had
+    // the wrong shape).
+    const bool several = fitters_.size() > 1;
+    if (seed == seeds_.end() || (several && pose && pose->searched))
       if (const std::optional<ShapeChoice> best = fitBestShape(fitters_, d.edge_points, d.centroid)) {
         pose = best->pose;
         shape = best->shape;
-        ++counts_.shape_choices;
+        if (several) ++counts_.shape_choices;
       }
-    } else if (seed == seeds_.end()) {
-      pose = fitters_[0].fit(d.edge_points, d.centroid);
-    }
     if (!pose) {
       ++counts_.unfitted;
       continue;

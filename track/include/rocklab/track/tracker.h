@@ -4,8 +4,9 @@
 // (link.h), and with a shape fit (useShapeFit) each linked detection's position
 // becomes the model-based one (shape_fit.h), seeded from its track's pose in the
 // previous frame (with several marker shapes, a track's first fit tries each and
-// keeps the best, fitBestShape, and its later fits use that shape), and a track whose fit repeats another's ends (one marker's blob
-// cut in two); at the end, tracks broken by a gap are stitched (stitch.h).
+// keeps the best, fitBestShape, and its later fits use that shape), and a track
+// whose fit repeats another's ends (one marker's blob cut in two); at the end,
+// tracks broken by a gap are stitched (stitch.h).
 #include <optional>
 #include <unordered_map>
 #include <vector>
