@@ -22,6 +22,10 @@
 
 namespace rocklab::sim {
 
+namespace bond_law {
+struct BondConstants;
+}
+
 // Reduction of the per-step checks; merged in a thread-independent way (max, or).
 struct StepChecks {
   double max_disp2 = 0.0;        // m^2, largest squared displacement since the last rebuild
@@ -427,6 +431,8 @@ struct World::Impl {
   template <class Law> void forcePass(bool integrate_now, double h, StepChecks& merged);
   // 4. bonds (stages/bonds.cpp; contact bonds in stages/contact_bonds.cpp)
   void bondStage(StepChecks& checks);
+  // The intact parallel bonds k[0 .. lanes of R) through the bond law (bond_law.h).
+  template <class R> bool stepParallelBonds(const std::size_t* k, const bond_law::BondConstants& law);
   template <class Law> std::uint8_t contactBondStep(std::size_t k, StepChecks& c);
   std::uint8_t contactBondStepAny(std::size_t k, StepChecks& c);
   void installContactBond(std::size_t k);

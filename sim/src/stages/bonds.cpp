@@ -2,6 +2,7 @@
 #include <sstream>
 
 #include "../world_impl.h"
+#include "bond_law.h"
 
 namespace rocklab::sim {
 
@@ -15,7 +16,7 @@ namespace rocklab::sim {
 // contact bond breaks, bonds.handover and nb.need_rebuild (its pair rejoins the
 // neighbour list at the next step); the overlap check of contact-bonded pairs.
 //
-// Threads: the update runs over bonds (each writes only its own entries), the
+// Threads: the update runs over pairs of bonds (each writes only its own entries), the
 // sums over balls, each adding its bonds in ascending bond order: bitwise the
 // same on any number of threads.
 
@@ -37,48 +38,71 @@ BondDisc bondDisc(double radius) {
 
 BondStress bondStress(const BondDisc& d, double normal_force, const Vec3& shear_force,
                       double twist_moment, const Vec3& bend_moment) {
-  BondStress s;
-  s.tensile = -normal_force / d.area + bend_moment.norm() * d.radius / d.inertia;  // Eq 2-33 [R]
-  s.shear =
-      shear_force.norm() / d.area + std::abs(twist_moment) * d.radius / d.polar;  // Eq 2-34 [R]
+  BondStress s;  // the bond stage's own arithmetic, so a logged break matches its check
+  bond_law::peakStresses(d.radius, d.area, normal_force, shear_force.norm(), std::abs(twist_moment),
+                         bend_moment.norm(), s.tensile, s.shear);
   return s;
 }
 
-namespace {
-
-/// How a bond's contact plane turned in one step: tilted from the normal n_old
-/// to n, and spun about n by the mean of the balls' spins. Computed once per
-/// bond and applied to its shear force and its bending moment.
-struct PlaneTurn {
-  Vec3 n, k;   // k = n_old x n, |k| = sin of the tilt
-  double c;    // cos of the tilt
-  bool tilts;  // false when the normal turned over in one step (no defined rotation)
-  double sin_spin, cos_spin;
-
-  PlaneTurn(const Vec3& n_old, const Vec3& n_new, double spin) : n(n_new), k(n_old.cross(n_new)) {
-    c = n_old.dot(n_new);
-    tilts = c > -1.0 + 1e-12;
-    // The series is exact to round-off for the tiny angles of one step and
-    // saves two trigonometric calls.
-    if (std::abs(spin) < 1e-3) {
-      const double a2 = spin * spin;
-      sin_spin = spin * (1.0 - a2 / 6.0);
-      cos_spin = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
-    } else {
-      sin_spin = std::sin(spin);
-      cos_spin = std::cos(spin);
+/// Steps the intact parallel bonds k (one or two, the lanes of R) through the
+/// bond law and stores their state and forces; a bond that broke is deleted at
+/// once (ref §8.2): it carries nothing in the step it breaks, so a pair whose
+/// bond breaks at once moves exactly as if never bonded. Returns whether any broke.
+template <class R>
+bool World::Impl::stepParallelBonds(const std::size_t* k, const bond_law::BondConstants& law) {
+  using bond_law::gather;
+  using bond_law::gather3;
+  using bond_law::laneOf;
+  BondState& s = bonds.state;
+  const auto a = [&](int lane) { return s.a[k[lane]]; };
+  const auto b = [&](int lane) { return s.b[k[lane]]; };
+  bond_law::BondInput<R> in;
+  in.xa = gather3<R>([&](int l) -> const Vec3& { return p.position[a(l)]; });
+  in.xb = gather3<R>([&](int l) -> const Vec3& { return p.position[b(l)]; });
+  in.va = gather3<R>([&](int l) -> const Vec3& { return p.velocity[a(l)]; });
+  in.vb = gather3<R>([&](int l) -> const Vec3& { return p.velocity[b(l)]; });
+  in.wa = gather3<R>([&](int l) -> const Vec3& { return p.omega[a(l)]; });
+  in.wb = gather3<R>([&](int l) -> const Vec3& { return p.omega[b(l)]; });
+  in.ra = gather<R>([&](int l) { return p.radius[a(l)]; });
+  in.rb = gather<R>([&](int l) { return p.radius[b(l)]; });
+  in.normal = gather3<R>([&](int l) -> const Vec3& { return s.normal[k[l]]; });
+  in.normal_force = gather<R>([&](int l) { return s.normal_force[k[l]]; });
+  in.shear_force = gather3<R>([&](int l) -> const Vec3& { return s.shear_force[k[l]]; });
+  in.twist_moment = gather<R>([&](int l) { return s.twist_moment[k[l]]; });
+  in.bend_moment = gather3<R>([&](int l) -> const Vec3& { return s.bend_moment[k[l]]; });
+  in.radius = gather<R>([&](int l) { return s.radius[k[l]]; });
+  in.tensile_strength = gather<R>([&](int l) { return s.tensile_strength[k[l]]; });
+  in.shear_strength = gather<R>([&](int l) { return s.shear_strength[k[l]]; });
+  const bond_law::BondOutput<R> out = bond_law::stepBond(in, law);
+  bool any_broke = false;
+  for (int lane = 0; lane < bond_law::kLanes<R>; ++lane) {
+    const std::size_t j = k[lane];
+    s.normal[j] = laneOf(out.normal, lane);
+    s.normal_force[j] = laneOf(out.normal_force, lane);
+    s.shear_force[j] = laneOf(out.shear_force, lane);
+    s.twist_moment[j] = laneOf(out.twist_moment, lane);
+    s.bend_moment[j] = laneOf(out.bend_moment, lane);
+    if (laneOf(out.broke, lane)) {
+      s.intact[j] = 0;
+      // The mode is the larger of the two ratios (the only divisions, and only here).
+      const double tensile_ratio = laneOf(out.tensile, lane) / s.tensile_strength[j];
+      const double shear_ratio = laneOf(out.shear, lane) / s.shear_strength[j];
+      bonds.broke[j] = tensile_ratio >= shear_ratio ? Bonds::kTensile : Bonds::kShear;
+      bonds.force_b[j].setZero();
+      bonds.torque_a[j].setZero();
+      bonds.torque_b[j].setZero();
+      any_broke = true;
+      continue;
     }
+    bonds.broke[j] = 0;
+    bonds.force_b[j] = laneOf(out.force_b, lane);
+    bonds.torque_a[j] = laneOf(out.torque_a, lane);
+    bonds.torque_b[j] = laneOf(out.torque_b, lane);
   }
+  return any_broke;
+}
 
-  /// v (in the old plane) carried into the new one: the tilt by Rodrigues with
-  /// the unnormalised axis k (k (k.v) (1 - cos) / sin^2 = k (k.v) / (1 + cos)),
-  /// then the spin about n, then any round-off drift out of the plane removed.
-  [[gnu::always_inline]] Vec3 carry(const Vec3& v) const {
-    const Vec3 tilted = tilts ? Vec3(c * v + k.cross(v) + k * (k.dot(v) / (1.0 + c))) : v;
-    const Vec3 r = cos_spin * tilted + sin_spin * n.cross(tilted);
-    return r - r.dot(n) * n;
-  }
-};
+namespace {
 
 // The step checks merged across threads (mergeChecks: max and or, any order).
 #pragma omp declare reduction(mergeStepChecks : StepChecks : mergeChecks(omp_out, omp_in)) \
@@ -89,89 +113,42 @@ struct PlaneTurn {
 void World::Impl::bondStage(StepChecks& checks) {
   BondState& s = bonds.state;
   const ParallelBondModel& bm = model.bonds;
-  const double kn = bm.normal_stiffness, ks = bm.shear_stiffness;
-  const bool combined = bm.failure_rule == BondFailureRule::Combined;
-  const auto nbonds = static_cast<std::ptrdiff_t>(s.size());
-  const double h = dt;
+  const bond_law::BondConstants law{bm.normal_stiffness, bm.shear_stiffness, dt,
+                                    bm.failure_rule == BondFailureRule::Combined};
+  // Bonds go in pairs, two parallel bonds at once through the two-lane law
+  // (bond_law.h: the same bits as one at a time); a pair with a contact bond or
+  // a broken bond goes one by one.
+  const auto npairs = static_cast<std::ptrdiff_t>((s.size() + 1) / 2);
   constexpr auto kContact = static_cast<std::uint8_t>(BondKind::Contact);
+  const auto isIntactParallel = [&](std::size_t k) { return s.intact[k] && s.kind[k] != kContact; };
   bool any_broke = false;
   StepChecks bonded;  // the overlaps of contact-bonded pairs
   // clang-format off
 #pragma omp parallel for schedule(static) num_threads(bondTeamSize()) \
     reduction(|| : any_broke) reduction(mergeStepChecks : bonded)
   // clang-format on
-  for (std::ptrdiff_t kk = 0; kk < nbonds; ++kk) {
-    const auto k = static_cast<std::size_t>(kk);
-    bonds.broke[k] = 0;
-    if (!s.intact[k]) continue;
-    if (s.kind[k] == kContact) {
-      if (const std::uint8_t how = contactBondStepAny(k, bonded)) {
-        s.intact[k] = 0;
-        bonds.broke[k] = how;
-        any_broke = true;
+  for (std::ptrdiff_t jj = 0; jj < npairs; ++jj) {
+    const std::size_t k0 = 2 * static_cast<std::size_t>(jj), k1 = k0 + 1;
+    if (k1 < s.size() && isIntactParallel(k0) && isIntactParallel(k1)) {
+      const std::size_t both[2] = {k0, k1};
+      any_broke |= stepParallelBonds<bond_law::BondPair>(both, law);
+      continue;
+    }
+    for (const std::size_t k : {k0, k1}) {
+      if (k >= s.size()) break;
+      bonds.broke[k] = 0;
+      if (!s.intact[k]) continue;
+      if (s.kind[k] == kContact) {
+        if (const std::uint8_t how = contactBondStepAny(k, bonded)) {
+          s.intact[k] = 0;
+          bonds.broke[k] = how;
+          any_broke = true;
+        }
+        continue;
       }
-      continue;
+      const std::size_t one[1] = {k};
+      any_broke |= stepParallelBonds<double>(one, law);
     }
-    const std::uint32_t a = s.a[k], b = s.b[k];
-    const Vec3& xa = p.position[a];
-    const Vec3& xb = p.position[b];
-    const Vec3 d = xb - xa;
-    const double dist = d.norm();
-    const Vec3 n_old = s.normal[k];
-    const Vec3 n = dist > 0 ? Vec3(d / dist) : n_old;
-    const Vec3 xc = bondPoint(xa, p.radius[a], p.radius[b], n, dist);
-    // Stored shear force and bending moment turn with the contact plane: its
-    // tilt (n_old -> n) and its spin about n, the mean of the balls' spins.
-    const PlaneTurn turn(n_old, n, 0.5 * (p.omega[a] + p.omega[b]).dot(n) * h);
-    // Increments (Eq 2-29..2-32): relative motion of b against a at the bond.
-    const Vec3 v_rel =
-        (p.velocity[b] + p.omega[b].cross(xc - xb)) - (p.velocity[a] + p.omega[a].cross(xc - xa));
-    const double du_n = v_rel.dot(n) * h;  // > 0 when separating
-    const Vec3 du_s = (v_rel - v_rel.dot(n) * n) * h;
-    const Vec3 dtheta = (p.omega[b] - p.omega[a]) * h;
-    const double dtheta_n = dtheta.dot(n);
-    const Vec3 dtheta_s = dtheta - dtheta_n * n;
-    const BondDisc disc = bondDisc(s.radius[k]);
-    const double fn = s.normal_force[k] - kn * disc.area * du_n;               // Eq 2-29
-    const Vec3 fs = turn.carry(s.shear_force[k]) - (ks * disc.area) * du_s;    // Eq 2-30 [R]
-    const double mn = s.twist_moment[k] - ks * disc.polar * dtheta_n;          // Eq 2-31 [R]
-    const Vec3 ms = turn.carry(s.bend_moment[k]) - (kn * disc.inertia) * dtheta_s;  // Eq 2-32
-    s.normal[k] = n;
-    s.normal_force[k] = fn;
-    s.shear_force[k] = fs;
-    s.twist_moment[k] = mn;
-    s.bend_moment[k] = ms;
-
-    const BondStress stress = bondStress(disc, fn, fs, mn, ms);
-    double tensile_ratio, shear_ratio;
-    if (combined) {
-      // Each force or moment against its own capacity; the parts add up.
-      tensile_ratio = std::max(-fn, 0.0) / (s.tensile_strength[k] * disc.area) +
-                      ms.norm() * disc.radius / (s.tensile_strength[k] * disc.inertia);
-      shear_ratio = fs.norm() / (s.shear_strength[k] * disc.area) +
-                    std::abs(mn) * disc.radius / (s.shear_strength[k] * disc.polar);
-    } else {
-      tensile_ratio = stress.tensile / s.tensile_strength[k];
-      shear_ratio = stress.shear / s.shear_strength[k];
-    }
-    const bool broke = combined ? tensile_ratio + shear_ratio >= 1.0
-                                : (tensile_ratio >= 1.0 || shear_ratio >= 1.0);
-    if (broke) {
-      // Deleted at once (ref §8.2): it carries nothing in the step it breaks, so
-      // a pair whose bond breaks at once moves exactly as if never bonded.
-      s.intact[k] = 0;
-      bonds.broke[k] = tensile_ratio >= shear_ratio ? Bonds::kTensile : Bonds::kShear;
-      bonds.force_b[k].setZero();
-      bonds.torque_a[k].setZero();
-      bonds.torque_b[k].setZero();
-      any_broke = true;
-      continue;
-    }
-    const Vec3 f = fn * n + fs;  // on b (Eq 2-27)
-    const Vec3 m = mn * n + ms;  // on b (Eq 2-28)
-    bonds.force_b[k] = f;
-    bonds.torque_b[k] = m + (xc - xb).cross(f);
-    bonds.torque_a[k] = -m - (xc - xa).cross(f);
   }
   mergeChecks(checks, bonded);
   if (any_broke) {
