@@ -211,6 +211,9 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
     CHECK(p["runs"][0]["psd"] == c["psd"]);
     CHECK(p["runs"][0]["p80_mm"] == c["p80_mm"]);
     CHECK(p["runs"][0]["feed"] == "spheres");
+    CHECK(p["runs"][0]["discharged_fraction"].get<double>() == Approx(1.0).epsilon(1e-12));
+    CHECK(p["runs"][0]["bonds_broken"].is_null());  // spheres: no bonds
+    CHECK(p["runs"][0]["legend"] == "first");       // emptied: the label alone
     const std::string table = test::slurp(products / "products.csv");
     CHECK(std::count(table.begin(), table.end(), '\n') == 3);  // header + 2 runs
     CHECK(fs::exists(products / "product_curves.png"));
@@ -223,6 +226,27 @@ TEST_CASE("a tiny crusher run: the feed falls from the bin through the moving ch
     bad["crusher"]["psd"][2]["passing"] = 1.5;
     std::ofstream(damaged / "results.json") << bad.dump();
   }
+  // A run stopped before its chamber emptied says so in the chart's legend, with
+  // how much of its feed its curve holds.
+  const fs::path partial = test::scratchDir("crusher-run-partial");
+  fs::create_directories(partial);
+  {
+    std::ifstream r_in(out / "results.json");
+    auto cut = nlohmann::json::parse(r_in);
+    cut["crusher"]["empty"] = false;
+    cut["crusher"]["discharged_mass_kg"] = 0.25 * cut["crusher"]["feed_mass_kg"].get<double>();
+    cut["simulated_time_s"] = 1.5;
+    std::ofstream(partial / "results.json") << cut.dump();
+  }
+  REQUIRE(test::cli({"products", out.string(), partial.string(), "--out", products.string()}) == 0);
+  {
+    std::ifstream p_in(products / "products.json");
+    const auto p = nlohmann::json::parse(p_in);
+    CHECK(p["runs"][1]["discharged_fraction"].get<double>() == Approx(0.25).epsilon(1e-12));
+    CHECK(p["runs"][1]["legend"] == p["runs"][1]["label"].get<std::string>() +
+                                        " (not empty: 25 % of the feed by t = 1.50 s)");
+  }
+  fs::remove_all(partial);
   const fs::path nothing = test::scratchDir("crusher-run-products-bad");
   std::string log;
   CHECK(test::cliLogged({"products", out.string(), damaged.string(), "--out", nothing.string()}, log) == 2);

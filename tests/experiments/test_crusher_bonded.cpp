@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -53,7 +54,9 @@ const std::string kStopWall =
     "material = \"rock\"\nactive_until = 0.4\n";
 
 /// Runs `scene_text` (written to a scratch folder) with `sets`; results.json.
-nlohmann::json run(const std::string& name, const std::string& scene_text, const std::vector<std::string>& sets = {}) {
+/// `inspect` sees the run's folder before it is removed.
+nlohmann::json run(const std::string& name, const std::string& scene_text, const std::vector<std::string>& sets = {},
+                   const std::function<void(const fs::path&)>& inspect = {}) {
   const fs::path dir = test::scratchDir("bonded-" + name);
   fs::create_directories(dir);
   std::ofstream(dir / "scene.toml") << scene_text;
@@ -72,6 +75,7 @@ nlohmann::json run(const std::string& name, const std::string& scene_text, const
     for (std::string cell; std::getline(row, cell, ',');) v.push_back(std::stod(cell));
     r["product_rows"].push_back(v);  // id, time_s, diameter_mm, mass_kg, residence_s
   }
+  if (inspect) inspect(dir / "out");
   fs::remove_all(dir);
   return r;
 }
@@ -133,8 +137,20 @@ TEST_CASE("a bonded crusher feed is discharged by fragments sized by Eq 6-15, ma
   SECTION("colliding at 8 m/s with weak bonds: fragments, each by Eq 6-15, mass kept") {
     const std::string two = agglomerates(1, "0.0", "0.03", "-0.05", "-0.015", "[4, 0, 0]") +
                             agglomerates(1, "0.0", "0.03", "0.015", "0.05", "[-4, 0, 0]");
-    const nlohmann::json r = run("collide", feedScene(two, "", 2e5), {"scene.end_time=1.5"});
+    // `rocklab products` counts a bonded run's breakage by its bonds.
+    nlohmann::json compared;
+    const nlohmann::json r = run("collide", feedScene(two, "", 2e5), {"scene.end_time=1.5"}, [&](const fs::path& out) {
+      const fs::path products = out / "products";
+      REQUIRE(test::cli({"products", out.string(), "--out", products.string()}) == 0);
+      std::ifstream in(products / "products.json");
+      compared = nlohmann::json::parse(in)["runs"][0];
+    });
     const auto& c = r["crusher"];
+    CHECK(compared["feed"] == "bonded agglomerates (Eq 6-15 sizes)");
+    CHECK(compared["bonds_broken"].get<long>() ==
+          c["bonded"]["bonds"].get<long>() - c["bonded"]["bonds_intact_at_end"].get<long>());
+    CHECK(compared["bonds_broken"].get<long>() > 0);
+    CHECK(compared["discharged_fraction"].get<double>() == Approx(1.0).epsilon(1e-12));
     const double porosity = c["bonded"]["porosity_mean"].get<double>();
     CHECK(c["empty"] == true);
     CHECK(c["discharged_balls"].get<int>() > 2);  // they broke
