@@ -75,8 +75,13 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
 }
 
 std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings,
-                                     const std::vector<cv::Point2d>& predictions) {
+                                     const std::vector<cv::Point2d>& predictions,
+                                     const std::vector<double>& prediction_areas) {
   settings.validate();
+  if (!prediction_areas.empty() && prediction_areas.size() != predictions.size())
+    throw std::invalid_argument("detectMarkers: " + std::to_string(prediction_areas.size()) +
+                                " prediction areas for " + std::to_string(predictions.size()) +
+                                " predictions (allowed: none, or one a prediction)");
   if (bgr.empty() || bgr.type() != CV_8UC3)
     throw std::invalid_argument("detectMarkers: the image must be 8-bit BGR (CV_8UC3) and not empty");
 
@@ -113,12 +118,16 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
 
   // Predictions per component (stage 4a): which tracks expect to be in it.
   std::vector<std::vector<cv::Point2d>> predicted(static_cast<std::size_t>(count));
+  std::vector<double> predicted_area(static_cast<std::size_t>(count), 0.0);  // of a lone prediction
   // Within a pixel (rounding): a prediction outside the blob belongs to a marker
   // that is hidden or elsewhere, and must not cut a lone marker in two.
   const int reach = 1;
-  for (const cv::Point2d& p : predictions)
-    if (const int label = labelNear(components, p - cv::Point2d(origin), reach); label > 0)
-      predicted[static_cast<std::size_t>(label)].push_back(p);
+  for (std::size_t k = 0; k < predictions.size(); ++k)
+    if (const int label = labelNear(components, predictions[k] - cv::Point2d(origin), reach); label > 0) {
+      const auto l = static_cast<std::size_t>(label);
+      predicted[l].push_back(predictions[k]);
+      predicted_area[l] = prediction_areas.empty() ? 0.0 : prediction_areas[k];
+    }
 
   // The reference at a component (its box centre): off the optical axis a marker
   // covers 1 / cos θ times its area on the axis (with focal_px and a fixed area).
@@ -134,14 +143,16 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
     const int label = candidates[c];
     const cv::Rect& box = components.boxes[static_cast<std::size_t>(label)];
     const detail::Blob blob = detail::componentBlob(components, label, box, origin);
-    const double local = referenceAt(box);
+    const std::vector<cv::Point2d>& seeds = predicted[static_cast<std::size_t>(label)];
+    // One tracked marker of known size in it: one marker covers up to that size.
+    const double local = seeds.size() == 1 ? std::max(referenceAt(box), predicted_area[static_cast<std::size_t>(label)])
+                                           : referenceAt(box);
     // More than one marker can cover (markers of one size): stage 4c.
     const double marker_max = settings.marker_max_ratio > 0 ? settings.marker_max_ratio * local
                                                             : std::numeric_limits<double>::infinity();
     // 5. measure the whole component; 4. split it if it is touching markers
     // (large and not round, or more than one marker covers), measuring each piece; 6. filter.
     std::vector<Detection> found{detail::measureBlob(bgr, blob)};
-    const std::vector<cv::Point2d>& seeds = predicted[static_cast<std::size_t>(label)];
     std::vector<detail::Blob> pieces;
     if (seeds.size() >= 2 && areas[c] > settings.seeded_split_ratio * local) {
       pieces = detail::splitBlobAt(blob, seeds);

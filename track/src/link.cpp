@@ -154,6 +154,14 @@ std::vector<cv::Point2d> Linker::predictions(int frame, double time) const {
   return out;
 }
 
+std::vector<int> Linker::predictedTracks(int frame) const {
+  std::vector<int> out;
+  out.reserve(active_.size());
+  for (const int id : active_)
+    if (!retired(id, frame)) out.push_back(id);
+  return out;
+}
+
 std::vector<Track> Linker::tracks() const {
   std::vector<Track> out;
   out.reserve(tracks_.size());

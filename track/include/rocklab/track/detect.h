@@ -112,7 +112,13 @@ std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings&
 
 /// The same, with the tracks' predicted pixels for this frame (Linker::predictions):
 /// a component two or more predictions fall into is split at them (stage 4a).
+/// `prediction_areas` (empty, or one a prediction; 0 = unknown): the area [px²]
+/// that prediction's marker is known to cover. A component that holds exactly one
+/// prediction of known area is one marker up to that area: stages 4b and 4c take
+/// the larger of it and the reference (with markers of several sizes, a large one's
+/// blob is not cut in two by the size of a small one).
 std::vector<Detection> detectMarkers(const cv::Mat& bgr, const DetectorSettings& settings,
-                                     const std::vector<cv::Point2d>& predictions);
+                                     const std::vector<cv::Point2d>& predictions,
+                                     const std::vector<double>& prediction_areas = {});
 
 }  // namespace rocklab::track

@@ -78,6 +78,8 @@ class Linker {
   /// marker (step 2), for the detector's prediction-seeded split (detect.h, 4a).
   /// Does not change the linker.
   std::vector<cv::Point2d> predictions(int frame, double time) const;
+  /// The track of each of predictions(frame, ...), in the same order.
+  std::vector<int> predictedTracks(int frame) const;
 
   /// Every track so far (ended or not; withdrawn ones with no point left are left
   /// out), by id.

@@ -5,7 +5,8 @@
 // becomes the model-based one (shape_fit.h), seeded from its track's pose in the
 // previous frame (with several marker shapes, a track's first fit tries each and
 // keeps the best, fitBestShape, and its later fits use that shape), and a track
-// whose fit repeats another's ends (one marker's blob cut in two); at the end,
+// whose fit repeats another's ends (one marker's blob cut in two; the other track
+// keeps both pieces' area as its marker's, so its blob is not cut by size again); at the end,
 // tracks broken by a gap are stitched (stitch.h).
 #include <optional>
 #include <unordered_map>
@@ -66,6 +67,10 @@ class Tracker {
   Linker linker_;
   std::vector<ShapeFitter> fitters_;  // none: centroids
   std::unordered_map<int, Seed> seeds_;  // by track id: its last fitted pose
+  // By track id: the area its marker covers [px²], learnt when its blob was cut in
+  // two and both pieces fit it (the duplicate rule); the detector's size rules then
+  // leave a blob of that size with its prediction whole.
+  std::unordered_map<int, double> marker_areas_;
   ShapeFitCounts counts_;
 };
 
