@@ -53,10 +53,6 @@ R absOf(R x) {
   return pick(x < 0.0, -x, x);
 }
 template <class R>
-R maxOf(R a, R b) {  // std::max(a, b): b only when a < b
-  return pick(a < b, b, a);
-}
-template <class R>
 R minOf(R a, R b) {  // std::min(a, b): b only when b < a
   return pick(b < a, b, a);
 }
