@@ -148,9 +148,8 @@ bool Linker::retired(int id, int frame) const {
 
 std::vector<cv::Point2d> Linker::predictions(int frame, double time) const {
   std::vector<cv::Point2d> out;
-  out.reserve(active_.size());
-  for (const int id : active_)
-    if (!retired(id, frame)) out.push_back(predict(tracks_[static_cast<std::size_t>(id)], time));
+  for (const int id : predictedTracks(frame))
+    out.push_back(predict(tracks_[static_cast<std::size_t>(id)], time));
   return out;
 }
 

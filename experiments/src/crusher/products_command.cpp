@@ -184,32 +184,27 @@ int runProductsCommand(const RunComparisonOptions& o, std::ostream& out, std::os
     return kExitFailed;
   }
   // The console table: one space at least between columns, whatever a cell's width.
-  const auto column = [&](const std::string& text, int width) {
-    out << ' ' << std::setw(width) << text;
+  struct ConsoleColumn {
+    const char* header;
+    int width;
+    const char* figure;  // key of ProductRun::figures
+    double scale;        // shown as scale x the figure
   };
+  static constexpr ConsoleColumn kConsole[] = {
+      {"P50_mm", 9, "p50_mm", 1},       {"P80_mm", 9, "p80_mm", 1},
+      {"breakages", 9, "breakages", 1}, {"bonds_broken", 12, "bonds_broken", 1},
+      {"t/h", 9, "throughput_tph", 1},  {"empty", 5, "chamber_empty", 1},
+      {"discharged_%", 12, "discharged_fraction", 100}};
   out << std::left << std::setw(28) << "run" << std::right;
-  for (const auto& [name, width] : std::vector<std::pair<std::string, int>>{{"P50_mm", 9},
-                                                                            {"P80_mm", 9},
-                                                                            {"breakages", 9},
-                                                                            {"bonds_broken", 12},
-                                                                            {"t/h", 9},
-                                                                            {"empty", 5},
-                                                                            {"discharged_%", 12}})
-    column(name, width);
+  for (const ConsoleColumn& c : kConsole) out << ' ' << std::setw(c.width) << c.header;
   out << '\n';
   for (const ProductRun& run : runs) {
-    const nlohmann::json& f = run.figures;
     out << std::left << std::setw(28) << run.label << std::right;
-    column(detail::cell(f["p50_mm"]), 9);
-    column(detail::cell(f["p80_mm"]), 9);
-    column(detail::cell(f["breakages"]), 9);
-    column(detail::cell(f["bonds_broken"]), 12);
-    column(detail::cell(f["throughput_tph"]), 9);
-    column(detail::cell(f["chamber_empty"]), 5);
-    column(f["discharged_fraction"].is_number()
-               ? detail::cell(100 * f["discharged_fraction"].get<double>())
-               : "",
-           12);
+    for (const ConsoleColumn& c : kConsole) {
+      const nlohmann::json& v = run.figures[c.figure];
+      out << ' ' << std::setw(c.width)
+          << detail::cell(v.is_number() ? nlohmann::json(c.scale * v.get<double>()) : v);
+    }
     out << '\n';
   }
   out << "wrote " << (o.out_dir / "products.csv").string()

@@ -56,32 +56,6 @@ template <class R>
 R minOf(R a, R b) {  // std::min(a, b): b only when b < a
   return pick(b < a, b, a);
 }
-/// sin and cos of the plane's spin in one step: the series, exact to round-off
-/// for the tiny angles of one step, saves two trigonometric calls (a lane past
-/// it takes the library's).
-inline void spinSinCos(double a, double& s, double& c) {
-  if (std::abs(a) < 1e-3) {
-    const double a2 = a * a;
-    s = a * (1.0 - a2 / 6.0);
-    c = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
-  } else {
-    s = std::sin(a);
-    c = std::cos(a);
-  }
-}
-inline void spinSinCos(BondPair a, BondPair& s, BondPair& c) {
-  const BondPair a2 = a * a;
-  s = a * (1.0 - a2 / 6.0);
-  c = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
-  if (anyOf(absOf(a) >= 1e-3)) {
-    for (int lane = 0; lane < 2; ++lane) {
-      if (std::abs(a[lane]) < 1e-3) continue;
-      s[lane] = std::sin(a[lane]);
-      c[lane] = std::cos(a[lane]);
-    }
-  }
-}
-
 // --- lanes: a double is one bond, a pair two
 template <class R>
 constexpr int kLanes = 1;
@@ -108,6 +82,28 @@ inline bool laneOf(bool m, int) {
 inline bool laneOf(PairMask m, int lane) {
   return m[lane] != 0;
 }
+
+/// sin and cos of the plane's spin in one step: the series, exact to round-off
+/// for the tiny angles of one step, saves two trigonometric calls; a lane past it
+/// takes the library's. One text for one lane and two, so both round alike.
+template <class R>
+void spinSinCos(R a, R& s, R& c) {
+  const R a2 = a * a;
+  s = a * (1.0 - a2 / 6.0);
+  c = 1.0 - 0.5 * a2 * (1.0 - a2 / 12.0);
+  if (!anyOf(absOf(a) >= 1e-3)) return;
+  if constexpr (kLanes<R> == 1) {
+    s = std::sin(a);
+    c = std::cos(a);
+  } else {
+    for (int lane = 0; lane < kLanes<R>; ++lane) {
+      if (std::abs(a[lane]) < 1e-3) continue;
+      s[lane] = std::sin(a[lane]);
+      c[lane] = std::cos(a[lane]);
+    }
+  }
+}
+
 
 template <class R>
 struct V3 {
