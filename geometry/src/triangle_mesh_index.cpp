@@ -56,7 +56,8 @@ bool onEdgeOrVertex(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>
 
 }  // namespace
 
-TriangleMeshIndex::TriangleMeshIndex(const TriangleMesh& mesh) {
+TriangleMeshIndex::TriangleMeshIndex(const TriangleMesh& mesh, double smooth_angle)
+    : smooth_cos_(smooth_angle > 0 ? std::cos(smooth_angle) : 2.0) {
   auto t = std::make_shared<Tree>();
   t->mesh = mesh;
   t->triangles.reserve(mesh.triangles.size());
@@ -166,8 +167,10 @@ namespace {
 /// TriangleMeshIndex::touches. An edge or vertex touch is the same contact as a
 /// neighbour's when a nearer triangle holds that point (it shares the edge or
 /// vertex); such a triangle is nearer than r too, so it is among the candidates.
-void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, double r,
-                 std::vector<TriangleMeshIndex::Touch>& out) {
+/// A touch whose normal is within the smooth angle of a nearer kept one's
+/// (cosine above `smooth_cos`) is that one's smooth surface seen again.
+void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, const Vec3& p,
+                 double r, double smooth_cos, std::vector<TriangleMeshIndex::Touch>& out) {
   using Touch = TriangleMeshIndex::Touch;
   out.clear();
   auto byDistance = [](const Touch& a, const Touch& b) {
@@ -203,7 +206,12 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
     const bool seen = std::any_of(out.begin(), out.end(), [&](const Touch& m) {
       return (m.point - c.point).norm() <= 1e-12 * std::max(1.0, c.distance + r);
     });
-    if (!seen) out.push_back(c);
+    if (seen) continue;
+    // Normals as the contact takes them, from the surface towards the centre.
+    const bool smooth = smooth_cos <= 1.0 && c.distance > 0 && std::any_of(out.begin(), out.end(), [&](const Touch& m) {
+      return m.distance > 0 && (p - m.point).dot(p - c.point) > smooth_cos * m.distance * c.distance;
+    });
+    if (!smooth) out.push_back(c);
   }
 }
 
@@ -218,7 +226,7 @@ std::vector<TriangleMeshIndex::Touch> TriangleMeshIndex::touches(const Vec3& p, 
     if (d2 < r * r) candidates.push_back({q, k, std::sqrt(d2), d2});
   });
   std::vector<Touch> kept;
-  keepTouches(t.mesh, candidates, r, kept);
+  keepTouches(t.mesh, candidates, p, r, smooth_cos_, kept);
   return kept;
 }
 
@@ -241,7 +249,7 @@ void TriangleMeshIndex::touchesAmong(const Vec3& p, double r, std::span<const st
     const double d2 = (q - p).squaredNorm();
     if (d2 < r2) candidates.push_back({q, k, std::sqrt(d2), d2});
   }
-  keepTouches(t.mesh, candidates, r, out);
+  keepTouches(t.mesh, candidates, p, r, smooth_cos_, out);
 }
 
 }  // namespace rocklab::geometry

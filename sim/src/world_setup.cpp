@@ -47,6 +47,8 @@ std::string validateModel(const Model& model, const std::vector<SphereSpec>& sph
     if (w.shape == WallShape::Mesh) {
       const std::string msg = w.mesh.validate();
       if (!msg.empty()) return where + ": " + msg;
+      if (!(w.smooth_angle_deg >= 0 && w.smooth_angle_deg < 90))
+        return where + ": smooth_angle_deg must be in [0, 90) degrees";
     }
     if (!(w.active_until > w.active_from)) return where + ": active_until must be after active_from";
   }

@@ -2,6 +2,8 @@
 // the readings of its ambiguities, the mantle speed and spin sense). The chamber
 // is derived and checked by geometry::coneCrusherGeometry; its walls are appended
 // to the model as mesh walls, the mantle and its cap moving (gyration + spin).
+#include <algorithm>
+
 #include "rocklab/geometry/frustum_mesh.h"
 #include "scene/scene_internal.h"
 
@@ -43,12 +45,19 @@ geometry::SpinSense parseSpinSense(const std::string& v) {
   return geometry::SpinSense::Opposite;
 }
 
+/// The facets of a frustum of `segments` stand for a surface of revolution: their
+/// creases (at most 360 / segments degrees) are smooth (sim::Wall::smooth_angle_deg).
+double frustumSmoothAngleDeg(int segments) {
+  return std::max(sim::Wall{}.smooth_angle_deg, 1.5 * 360.0 / segments);
+}
+
 void addWall(Scene& scene, int material, const std::string& name, const geometry::TriangleMesh& mesh,
-             const WallLook& look, const sim::WallMotion& motion = {}) {
+             int segments, const WallLook& look, const sim::WallMotion& motion = {}) {
   sim::Wall w;
   w.name = name;
   w.shape = sim::WallShape::Mesh;
   w.mesh = mesh;
+  w.smooth_angle_deg = frustumSmoothAngleDeg(segments);
   w.material = material;
   w.motion = motion;
   scene.model.walls.push_back(std::move(w));
@@ -78,7 +87,7 @@ void addFeedWalls(TableReader& t, int material, const geometry::ConeCrusherGeome
   bin.facing = geometry::FrustumFacing::TowardAxis;
   WallLook bin_look;
   bin_look.colour = kFeedWallColour;
-  addWall(scene, material, "crusher.feed_bin", geometry::frustumMesh(bin), bin_look);
+  addWall(scene, material, "crusher.feed_bin", geometry::frustumMesh(bin), bin.segments, bin_look);
   sim::Wall stop_wall;
   stop_wall.name = "crusher.stop";
   stop_wall.shape = sim::WallShape::Plane;
@@ -126,10 +135,10 @@ void readCrusher(TableReader& root, const std::map<std::string, int>& materials,
   if (walls) {
     const geometry::ConeCrusherMeshes m = geometry::coneCrusherMeshes(g);
     const sim::WallMotion mantle = mantleWallMotion(geometry::mantleMotion(g, c.eccentric_rpm, c.spin_sense));
-    addWall(scene, c.material, "crusher.mantle", m.mantle, mantle_look, mantle);
-    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, mantle_look, mantle);
-    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, concave_look);
-    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, concave_look);
+    addWall(scene, c.material, "crusher.mantle", m.mantle, c.spec.segments, mantle_look, mantle);
+    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, c.spec.segments, mantle_look, mantle);
+    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, c.spec.segments, concave_look);
+    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, c.spec.segments, concave_look);
   }
   if (t->boolean("feed_bin", false)) addFeedWalls(*t, c.material, g, scene);
   scene.crusher = c;

@@ -30,8 +30,9 @@ struct CandidateDistances {
 class TriangleMeshIndex {
  public:
   TriangleMeshIndex() = default;  // no mesh: closestPoint must not be called
-  /// Copies what it needs of `mesh` (which must pass validate()).
-  explicit TriangleMeshIndex(const TriangleMesh& mesh);
+  /// Copies what it needs of `mesh` (which must pass validate()). Faces that meet
+  /// at less than `smooth_angle` (rad) stand for one smooth surface (touches()).
+  explicit TriangleMeshIndex(const TriangleMesh& mesh, double smooth_angle = 0.0);
 
   bool empty() const { return !tree_; }
   /// Closest point on the mesh surface to p.
@@ -72,7 +73,16 @@ class TriangleMeshIndex {
   /// when no triangle sharing that edge or vertex comes closer (else it is the
   /// same contact seen from a neighbour: a flat mesh split into triangles, a
   /// convex ridge or a cone's apex give one touch), and touches at the same point
-  /// are merged. A ball in a concave crease touching both faces gets two.
+  /// are merged. A ball in a concave crease touching both faces gets two, unless
+  /// their normals differ by less than the smooth angle: such a crease is the
+  /// tessellation of a smooth surface (a cone's 96 facets), which a ball touches
+  /// once, so only the nearer touch is kept. That keeps the contact energy a
+  /// continuous function of the ball's place: two touches whose normals differ by
+  /// theta appear only inside a wedge of angle theta over the crease, and where the
+  /// farther one appears its overlap is already that of the nearer less about
+  /// r (1 - cos theta) (a few micrometres at 3.75 degrees), so counting both would
+  /// switch a second, almost equal contact on and off as a pressed ball crosses
+  /// the crease (docs/crusher.md: the coarse bonded run's jam).
   /// Sorted by squared distance, then triangle (closestPointAmong's rule).
   std::vector<Touch> touches(const Vec3& p, double r) const;
   /// touches() over the given triangles only, into `out` (cleared first): the same
@@ -84,7 +94,8 @@ class TriangleMeshIndex {
 
  private:
   struct Tree;
-  std::shared_ptr<const Tree> tree_;  // shared: copies of an index (and of a wall) share one tree
+  std::shared_ptr<const Tree> tree_;
+  double smooth_cos_ = 2.0;  // cos of the smooth angle; 2: no two normals are that close  // shared: copies of an index (and of a wall) share one tree
 };
 
 }  // namespace rocklab::geometry

@@ -95,6 +95,11 @@ struct Wall {
   // Polygon: convex, planar, vertices in order. Mesh: triangles.
   std::vector<geometry::Vec3> vertices;
   geometry::TriangleMesh mesh;
+  // Mesh: faces meeting at less than this stand for one smooth surface, which a
+  // ball touches once (geometry::TriangleMeshIndex::touches says why): the
+  // tessellation of a curved wall, as LIGGGHTS's mesh `curvature`. Sharper
+  // creases are corners, each face its own contact. [0, 90) degrees.
+  double smooth_angle_deg = 10.0;
   int material = 0;
   WallMotion motion;
   double active_from = -std::numeric_limits<double>::infinity();   // s
