@@ -46,7 +46,11 @@ TEST_CASE("[crusher] builds the Table 6.1 chamber as mesh walls and refuses bad 
   for (const auto& w : s.model.walls) {
     CHECK(w.shape == rocklab::sim::WallShape::Mesh);
     CHECK(w.mesh.validate().empty());
+    CHECK(w.smooth_angle_deg == 10.0);  // the 96 facets meet at 3.75 degrees: one smooth surface
   }
+  // A coarser tessellation is still one smooth surface: at least 1.5 x its facets' angle.
+  for (const auto& w : loadScene(kCrusherScene, {"crusher.segments=24"}).model.walls)
+    CHECK(w.smooth_angle_deg == Approx(22.5));
   // The mantle and its cap gyrate and spin; the concaves stay.
   CHECK(!s.model.walls[0].motion.isStatic());
   CHECK(!s.model.walls[1].motion.isStatic());
