@@ -168,7 +168,9 @@ namespace {
 /// neighbour's when a nearer triangle holds that point (it shares the edge or
 /// vertex); such a triangle is nearer than r too, so it is among the candidates.
 /// A touch whose normal is within the smooth angle of a nearer kept one's
-/// (cosine above `smooth_cos`) is that one's smooth surface seen again.
+/// (cosine above `smooth_cos`) is that one's smooth surface seen again. With a
+/// smooth angle, a nearer triangle across a concave crease sharper than it does
+/// not shadow: that is a corner, and the far face's edge is a contact of its own.
 void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, const Vec3& p,
                  double r, double smooth_cos, std::vector<TriangleMeshIndex::Touch>& out) {
   using Touch = TriangleMeshIndex::Touch;
@@ -188,6 +190,24 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
     const Vec3 on = closestPointOnTriangle(q, mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]);
     return (on - q).norm() <= 1e-9 * r;
   };
+  // Whether `near` and `far` meet at q in a concave crease sharper than the smooth
+  // angle: `far` rises towards p out of `near`'s plane, and their faces (both
+  // normals turned towards p) differ by more than the smooth angle. Over such a
+  // corner the far face's touch, at its edge, is r - |p - q| deep and goes on
+  // continuously into its face touch inside the crease's wedge, so it counts; a
+  // flatter crease is one smooth surface (below), and a convex one is shadowed.
+  auto sharpConcave = [&](std::size_t near, std::size_t far, const Vec3& q) {
+    if (smooth_cos > 1.0) return false;  // no smooth angle: every nearer face shadows
+    auto towardsP = [&](std::size_t k) {
+      const auto& f = mesh.triangles[k];
+      const Vec3 n = (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]).normalized();
+      return n.dot(p - q) < 0 ? Vec3(-n) : n;
+    };
+    const Vec3 n_near = towardsP(near), n_far = towardsP(far);
+    const auto& g = mesh.triangles[far];
+    const Vec3 centroid = (mesh.vertices[g[0]] + mesh.vertices[g[1]] + mesh.vertices[g[2]]) / 3.0;
+    return n_near.dot(n_far) < smooth_cos && n_near.dot(centroid - q) > 0;
+  };
   for (const Touch& c : candidates) {
     bool shadowed = false;
     if (onEdgeOrVertex(mesh, mesh.triangles[c.triangle], c.point)) {
@@ -196,6 +216,7 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
         if (o.distance >= c.distance * (1 - 1e-12) - 1e-300) break;  // sorted: no nearer one follows
         if (o.triangle == c.triangle) continue;
         if (holds(o.triangle, c.point)) {
+          if (sharpConcave(o.triangle, c.triangle, c.point)) continue;
           shadowed = true;
           break;
         }

@@ -171,7 +171,7 @@ TEST_CASE("a ball's touches on a mesh - one per contact and two in a concave cre
   CHECK(apex[0].distance == Approx(0.009).margin(1e-12));
 }
 
-TEST_CASE("a pressed ball's contact energy is continuous across a shallow concave crease when its faces are one smooth surface", "[geometry]") {
+TEST_CASE("a pressed ball's contact energy is continuous across a concave crease: one smooth surface within the smooth angle, a corner beyond it", "[geometry]") {
   // Two faces meeting at 176.25 degrees along the y axis (a valley, the crease of
   // a 96-facet concave), and a ball of 4.15 mm pressed 0.2 mm into it, moved
   // across the crease in steps of 0.5 um. The Hertz energy of its touches (sum of
@@ -179,16 +179,20 @@ TEST_CASE("a pressed ball's contact energy is continuous across a shallow concav
   // continuous function of the place. Counted as two faces, the second touch
   // switches on and off with almost the first one's overlap: the energy jumps by
   // about as much as it is.
-  const double half = 0.5 * 3.75 * M_PI / 180.0, L = 0.02, W = 0.02;
-  TriangleMesh valley;
-  valley.vertices = {{-L, -W, L * std::tan(half)}, {-L, W, L * std::tan(half)}, {0, -W, 0},
-                     {0, W, 0},  {L, -W, L * std::tan(half)}, {L, W, L * std::tan(half)}};
-  valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
-  const double r = 4.15e-3, pressed = 0.2e-3;
+  const double L = 0.02, W = 0.02, r = 4.15e-3;
+  auto valleyOf = [&](double crease_deg) {
+    const double rise = L * std::tan(0.5 * crease_deg * M_PI / 180.0);
+    TriangleMesh valley;
+    valley.vertices = {{-L, -W, rise}, {-L, W, rise}, {0, -W, 0}, {0, W, 0}, {L, -W, rise}, {L, W, rise}};
+    valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
+    return valley;
+  };
+  const TriangleMesh valley = valleyOf(3.75);
+  double pressed = 0.2e-3;
   auto worstJump = [&](const TriangleMeshIndex& index, std::size_t& most_touches) {
     double worst = 0, previous = -1, largest = 0;
     most_touches = 0;
-    for (int k = -2000; k <= 2000; ++k) {
+    for (int k = -6000; k <= 6000; ++k) {
       const Vec3 centre(0.5e-6 * k, 0.003, r - pressed);
       double energy = 0;
       const auto touches = index.touches(centre, r);
@@ -208,7 +212,19 @@ TEST_CASE("a pressed ball's contact energy is continuous across a shallow concav
   CHECK(smooth < 1e-3);
   CHECK(touches_faces == 2);
   CHECK(faces > 0.3);  // the hazard the smooth angle removes
-  // A crease sharper than the smooth angle is a corner: both faces, as before.
+  // A crease sharper than the smooth angle is a corner, each face its own contact,
+  // the far one's from its edge on: continuous too. A 20 degree crease and a ball
+  // pressed 0.1 r into it, deeper than r (1 - cos 20 deg) = 0.06 r, where the far
+  // face's touch appeared at once 0.042 r deep when the near face shadowed its edge.
+  pressed = 0.1 * r;
+  const TriangleMesh corner = valleyOf(20.0);
+  const double corner_smooth = worstJump(TriangleMeshIndex(corner, 10.0 * M_PI / 180.0), touches_smooth);
+  const double corner_shadowed = worstJump(TriangleMeshIndex(corner), touches_faces);
+  INFO("20 degree crease: largest energy step, far edge a contact " << corner_smooth << ", shadowed " << corner_shadowed);
+  CHECK(touches_smooth == 2);
+  CHECK(corner_smooth < 1e-3);
+  CHECK(corner_shadowed > 0.02);
+  // The 90 degree groove: both faces, as before.
   const double rest_z = r * std::sqrt(2.0) - 1e-4;
   TriangleMesh groove;
   groove.vertices = {{-0.1, -0.2, 0.1}, {-0.1, 0.2, 0.1}, {0, -0.2, 0}, {0, 0.2, 0}, {0.1, -0.2, 0.1}, {0.1, 0.2, 0.1}};

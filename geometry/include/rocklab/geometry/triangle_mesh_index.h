@@ -82,7 +82,10 @@ class TriangleMeshIndex {
   /// farther one appears its overlap is already that of the nearer less about
   /// r (1 - cos theta) (a few micrometres at 3.75 degrees), so counting both would
   /// switch a second, almost equal contact on and off as a pressed ball crosses
-  /// the crease (docs/crusher.md: the coarse bonded run's jam).
+  /// the crease (docs/crusher.md: the coarse bonded run's jam). A concave crease
+  /// sharper than the smooth angle is a corner: the nearer face does not shadow
+  /// the far face's edge there, whose touch goes on continuously into its face
+  /// touch inside the wedge. Without a smooth angle (0) every nearer face shadows.
   /// Sorted by squared distance, then triangle (closestPointAmong's rule).
   std::vector<Touch> touches(const Vec3& p, double r) const;
   /// touches() over the given triangles only, into `out` (cleared first): the same
