@@ -171,8 +171,9 @@ namespace {
 /// (cosine above `smooth_cos`) is that one's smooth surface seen again. With a
 /// smooth angle, a nearer triangle across a concave crease sharper than it does
 /// not shadow: that is a corner, and the far face's edge is a contact of its own.
-void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates, const Vec3& p,
-                 double r, double smooth_cos, std::vector<TriangleMeshIndex::Touch>& out) {
+void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>& candidates,
+                 const Vec3& p, double r, double smooth_cos,
+                 std::vector<TriangleMeshIndex::Touch>& out) {
   using Touch = TriangleMeshIndex::Touch;
   out.clear();
   auto byDistance = [](const Touch& a, const Touch& b) {
@@ -200,7 +201,9 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
     if (smooth_cos > 1.0) return false;  // no smooth angle: every nearer face shadows
     auto towardsP = [&](std::size_t k) {
       const auto& f = mesh.triangles[k];
-      const Vec3 n = (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]).normalized();
+      const Vec3 n = (mesh.vertices[f[1]] - mesh.vertices[f[0]])
+                         .cross(mesh.vertices[f[2]] - mesh.vertices[f[0]])
+                         .normalized();
       return n.dot(p - q) < 0 ? Vec3(-n) : n;
     };
     const Vec3 n_near = towardsP(near), n_far = towardsP(far);
@@ -229,9 +232,11 @@ void keepTouches(const TriangleMesh& mesh, std::vector<TriangleMeshIndex::Touch>
     });
     if (seen) continue;
     // Normals as the contact takes them, from the surface towards the centre.
-    const bool smooth = smooth_cos <= 1.0 && c.distance > 0 && std::any_of(out.begin(), out.end(), [&](const Touch& m) {
-      return m.distance > 0 && (p - m.point).dot(p - c.point) > smooth_cos * m.distance * c.distance;
-    });
+    const bool smooth = smooth_cos <= 1.0 && c.distance > 0 &&
+                        std::any_of(out.begin(), out.end(), [&](const Touch& m) {
+                          return m.distance > 0 && (p - m.point).dot(p - c.point) >
+                                                       smooth_cos * m.distance * c.distance;
+                        });
     if (!smooth) out.push_back(c);
   }
 }

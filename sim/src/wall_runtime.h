@@ -42,7 +42,8 @@ class WallRuntime {
     } else {
       unit_normal_ = Vec3::UnitZ();
       for (const Vec3& v : w.mesh.vertices) extent_ = std::max(extent_, (v - w.motion.pivot).norm());
-      mesh_index_ = geometry::TriangleMeshIndex(w.mesh, w.smooth_angle_deg * std::numbers::pi / 180.0);
+      mesh_index_ =
+          geometry::TriangleMeshIndex(w.mesh, w.smooth_angle_deg * std::numbers::pi / 180.0);
     }
   }
 

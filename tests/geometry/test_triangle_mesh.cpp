@@ -171,7 +171,10 @@ TEST_CASE("a ball's touches on a mesh - one per contact and two in a concave cre
   CHECK(apex[0].distance == Approx(0.009).margin(1e-12));
 }
 
-TEST_CASE("a pressed ball's contact energy is continuous across a concave crease: one smooth surface within the smooth angle, a corner beyond it", "[geometry]") {
+TEST_CASE(
+    "a pressed ball's contact energy is continuous across a concave crease: one smooth surface "
+    "within the smooth angle, a corner beyond it",
+    "[geometry]") {
   // Two faces meeting at 176.25 degrees along the y axis (a valley, the crease of
   // a 96-facet concave), and a ball of 4.15 mm pressed 0.2 mm into it, moved
   // across the crease in steps of 0.5 um. The Hertz energy of its touches (sum of
@@ -183,7 +186,8 @@ TEST_CASE("a pressed ball's contact energy is continuous across a concave crease
   auto valleyOf = [&](double crease_deg) {
     const double rise = L * std::tan(0.5 * crease_deg * M_PI / 180.0);
     TriangleMesh valley;
-    valley.vertices = {{-L, -W, rise}, {-L, W, rise}, {0, -W, 0}, {0, W, 0}, {L, -W, rise}, {L, W, rise}};
+    valley.vertices = {{-L, -W, rise}, {-L, W, rise}, {0, -W, 0},
+                       {0, W, 0},      {L, -W, rise}, {L, W, rise}};
     valley.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
     return valley;
   };
@@ -218,16 +222,20 @@ TEST_CASE("a pressed ball's contact energy is continuous across a concave crease
   // face's touch appeared at once 0.042 r deep when the near face shadowed its edge.
   pressed = 0.1 * r;
   const TriangleMesh corner = valleyOf(20.0);
-  const double corner_smooth = worstJump(TriangleMeshIndex(corner, 10.0 * M_PI / 180.0), touches_smooth);
+  const double corner_smooth =
+      worstJump(TriangleMeshIndex(corner, 10.0 * M_PI / 180.0), touches_smooth);
   const double corner_shadowed = worstJump(TriangleMeshIndex(corner), touches_faces);
-  INFO("20 degree crease: largest energy step, far edge a contact " << corner_smooth << ", shadowed " << corner_shadowed);
+  INFO("20 degree crease: largest energy step, far edge a contact "
+       << corner_smooth << ", shadowed " << corner_shadowed);
   CHECK(touches_smooth == 2);
   CHECK(corner_smooth < 1e-3);
   CHECK(corner_shadowed > 0.02);
   // The 90 degree groove: both faces, as before.
   const double rest_z = r * std::sqrt(2.0) - 1e-4;
   TriangleMesh groove;
-  groove.vertices = {{-0.1, -0.2, 0.1}, {-0.1, 0.2, 0.1}, {0, -0.2, 0}, {0, 0.2, 0}, {0.1, -0.2, 0.1}, {0.1, 0.2, 0.1}};
+  groove.vertices = {{-0.1, -0.2, 0.1}, {-0.1, 0.2, 0.1}, {0, -0.2, 0},
+                     {0, 0.2, 0},       {0.1, -0.2, 0.1}, {0.1, 0.2, 0.1}};
   groove.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
-  CHECK(TriangleMeshIndex(groove, 10.0 * M_PI / 180.0).touches(Vec3(0, 0.03, rest_z), r).size() == 2);
+  CHECK(TriangleMeshIndex(groove, 10.0 * M_PI / 180.0).touches(Vec3(0, 0.03, rest_z), r).size() ==
+        2);
 }

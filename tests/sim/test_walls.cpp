@@ -115,7 +115,8 @@ TEST_CASE("a ball in a mesh's concave crease touches both faces: as in the groov
   CHECK(xm.z() > r * std::sqrt(2.0) - 1e-4);
 }
 
-TEST_CASE("a ball pressed into a shallow concave mesh crease slides across it and keeps its energy", "[walls]") {
+TEST_CASE("a ball pressed into a shallow concave mesh crease slides across it and keeps its energy",
+          "[walls]") {
   // A frictionless, undamped ball squeezed 0.1 mm between a ceiling plane and a
   // valley of two faces at 176.25 degrees (a crease of a 96-facet concave),
   // shot across the crease: it rocks to and fro over it. The faces as one smooth
@@ -130,8 +131,9 @@ TEST_CASE("a ball pressed into a shallow concave mesh crease slides across it an
     sim::Wall valley = test::floorPlane();
     valley.name = "valley";
     valley.shape = sim::WallShape::Mesh;
-    valley.mesh.vertices = {{-L, -W, L * std::tan(half)}, {-L, W, L * std::tan(half)}, {0, -W, 0},
-                            {0, W, 0},  {L, -W, L * std::tan(half)}, {L, W, L * std::tan(half)}};
+    valley.mesh.vertices = {
+        {-L, -W, L * std::tan(half)}, {-L, W, L * std::tan(half)}, {0, -W, 0}, {0, W, 0},
+        {L, -W, L * std::tan(half)},  {L, W, L * std::tan(half)}};
     valley.mesh.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}};
     valley.smooth_angle_deg = smooth_angle_deg;
     const double z = r - pressed;
@@ -147,8 +149,9 @@ TEST_CASE("a ball pressed into a shallow concave mesh crease slides across it an
       });
       farthest = std::max(farthest, std::abs(world.particles().position[0].x()));
     }
-    INFO("smooth angle " << smooth_angle_deg << " deg: energy " << first << " J, largest change " << worst
-                         << " of it, farthest " << farthest * 1e3 << " mm from the crease");
+    INFO("smooth angle " << smooth_angle_deg << " deg: energy " << first << " J, largest change "
+                         << worst << " of it, farthest " << farthest * 1e3
+                         << " mm from the crease");
     CHECK(farthest > 0.3e-3);  // beyond the wedge (0.27 mm wide) on both sides
     return worst;
   };

@@ -51,8 +51,9 @@ double frustumSmoothAngleDeg(int segments) {
   return std::max(sim::Wall{}.smooth_angle_deg, 1.5 * 360.0 / segments);
 }
 
-void addWall(Scene& scene, int material, const std::string& name, const geometry::TriangleMesh& mesh,
-             int segments, const WallLook& look, const sim::WallMotion& motion = {}) {
+void addWall(Scene& scene, int material, const std::string& name,
+             const geometry::TriangleMesh& mesh, int segments, const WallLook& look,
+             const sim::WallMotion& motion = {}) {
   sim::Wall w;
   w.name = name;
   w.shape = sim::WallShape::Mesh;
@@ -136,9 +137,12 @@ void readCrusher(TableReader& root, const std::map<std::string, int>& materials,
     const geometry::ConeCrusherMeshes m = geometry::coneCrusherMeshes(g);
     const sim::WallMotion mantle = mantleWallMotion(geometry::mantleMotion(g, c.eccentric_rpm, c.spin_sense));
     addWall(scene, c.material, "crusher.mantle", m.mantle, c.spec.segments, mantle_look, mantle);
-    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, c.spec.segments, mantle_look, mantle);
-    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, c.spec.segments, concave_look);
-    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, c.spec.segments, concave_look);
+    addWall(scene, c.material, "crusher.mantle_cap", m.mantle_cap, c.spec.segments, mantle_look,
+            mantle);
+    addWall(scene, c.material, "crusher.lower_concave", m.lower_concave, c.spec.segments,
+            concave_look);
+    addWall(scene, c.material, "crusher.upper_concave", m.upper_concave, c.spec.segments,
+            concave_look);
   }
   if (t->boolean("feed_bin", false)) addFeedWalls(*t, c.material, g, scene);
   scene.crusher = c;

@@ -142,7 +142,7 @@ const std::vector<KeyDoc>& sceneKeyDocs() {
       {"walls", "scale", "", "(mesh) Factor on the coordinates (0.001 for a file in mm)."},
       {"walls", "offset", "m", "(mesh) Added to every vertex after the scale: places a file's part in the scene, or moves a mesh with one key (the heap funnel's height)."},
       {"walls", "triangles", "", "(mesh) Triangles as vertex indices [[i, j, k], ...] (whole numbers from 0, each below the vertex count), without `file`."},
-      {"walls", "smooth_angle_deg", "deg", "(mesh) Faces meeting at less than this angle are one smooth surface (a curved wall's tessellation): a ball touching two of them has one contact, the nearer face's. Sharper concave creases are corners, each face its own contact (the far face from its edge on); 0 = the nearer face shadows the far one's edge at any crease. [0, 90)."},
+      {"walls", "smooth_angle_deg", "deg", "(mesh) Faces meeting at less than this angle are one smooth surface (a curved wall's tessellation): a ball touching two of them has one contact, the nearer face's. Sharper concave creases are corners, each face its own contact (the far face from its edge on); 0 = the nearer face shadows the far one's edge at any crease."},
       {"walls", "min", "m", "(box) Lower corner."},
       {"walls", "max", "m", "(box) Upper corner."},
       {"walls", "open_top", "", "(box) Leave out the top face."},

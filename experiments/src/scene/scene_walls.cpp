@@ -97,9 +97,10 @@ void readWalls(TableReader& root, const std::map<std::string, int>& materials,
       }
       const std::string msg = w.mesh.validate();
       if (!msg.empty()) t.fail(t.has("file") ? "file" : "triangles", msg);
+      w.smooth_angle_deg =
+          t.number("smooth_angle_deg", w.smooth_angle_deg, Range{0.0, 90.0, false, true});
       // After the scale: places a part in the scene, or moves one (one key raises
       // the heap's funnel).
-      w.smooth_angle_deg = t.number("smooth_angle_deg", w.smooth_angle_deg, Range{0.0, 90.0, false, true});
       const Vec3 offset = t.vec3("offset", Vec3::Zero());
       for (Vec3& v : w.mesh.vertices) v += offset;
       model.walls.push_back(w);

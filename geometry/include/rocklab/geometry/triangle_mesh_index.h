@@ -97,8 +97,8 @@ class TriangleMeshIndex {
 
  private:
   struct Tree;
-  std::shared_ptr<const Tree> tree_;
-  double smooth_cos_ = 2.0;  // cos of the smooth angle; 2: no two normals are that close  // shared: copies of an index (and of a wall) share one tree
+  std::shared_ptr<const Tree> tree_;  // shared: copies of an index (and of a wall) share one tree
+  double smooth_cos_ = 2.0;           // cos of the smooth angle; 2: no two normals are that close
 };
 
 }  // namespace rocklab::geometry
